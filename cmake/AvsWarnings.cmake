@@ -1,0 +1,9 @@
+# avs_apply_warnings(target): one place for the project's warning flags.
+# AVS_WERROR (ON in CI) turns warnings into errors.
+option(AVS_WERROR "Treat compiler warnings as errors" OFF)
+function(avs_apply_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-missing-field-initializers)
+  if(AVS_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+endfunction()

@@ -1,0 +1,95 @@
+// A launch graph after loading and validation: containers (processes) holding
+// component instances. Produced by load_graph(), consumed by `avs launch` and containers.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "avs/runtime/parameters.hpp"
+#include "avs/runtime/qos.hpp"
+#include "avs/runtime/time.hpp"
+
+namespace avs::graph {
+
+struct SourceLocation {
+  std::string file;
+  int line = 0;    ///< 1-based
+  int column = 0;  ///< 1-based
+  std::string str() const { return file + ":" + std::to_string(line) + ":" + std::to_string(column); }
+};
+
+/// One validation error: "file:line:column: error: <message>".
+struct Diagnostic {
+  SourceLocation where;
+  std::string message;
+  std::string str() const { return where.str() + ": error: " + message; }
+};
+
+struct ComponentInstance {
+  std::string type;  ///< registered component type
+  std::string name;  ///< unique in the graph
+  runtime::ParameterValues parameters;  ///< every declared parameter, defaults filled in
+  std::map<std::string, std::string> remaps;            ///< port -> ROS topic name (as written)
+  std::map<std::string, runtime::QosProfile> qos;       ///< port -> QoS override
+  SourceLocation where;
+};
+
+enum class ExecutorKind { single_threaded, thread_per_component };
+
+struct RespawnPolicy {
+  enum class Kind { never, on_failure, always } kind = Kind::never;
+  int max_restarts = 5;
+  double backoff_s = 1.0;  ///< doubled after each restart
+};
+
+struct ContainerSpec {
+  std::string name;
+  std::string host;  ///< empty: any host
+  ExecutorKind executor = ExecutorKind::single_threaded;
+  RespawnPolicy respawn;
+  std::vector<ComponentInstance> components;
+  SourceLocation where;
+};
+
+/// How time flows. `wall`: real time. `sim`: the `master` container runs a simulated clock
+/// (lockstep: as fast as possible, advancing only when every component there is idle;
+/// realtime: at `real_time_factor` x wall speed) and publishes it on /clock; other
+/// containers follow /clock.
+struct ClockSpec {
+  enum class Source { wall, sim } source = Source::wall;
+  enum class Mode { lockstep, realtime } mode = Mode::lockstep;
+  double real_time_factor = 1.0;
+  std::string master;  ///< container name; default: the first container
+  std::optional<double> duration_s;  ///< stop the graph after this much (sim or wall) time
+};
+
+struct Graph {
+  std::string file;
+  std::string ns = "/";  ///< namespace for relative topic names
+  int domain_id = 0;
+  ClockSpec clock;
+  std::vector<ContainerSpec> containers;
+  std::map<std::string, std::string> args;  ///< final argument values
+
+  const ContainerSpec* find_container(const std::string& name) const {
+    for (const auto& c : containers) {
+      if (c.name == name) return &c;
+    }
+    return nullptr;
+  }
+};
+
+/// Result of loading: a graph, or every error found (nothing is started on errors).
+struct LoadResult {
+  std::optional<Graph> graph;
+  std::vector<Diagnostic> errors;
+  bool ok() const { return graph.has_value() && errors.empty(); }
+};
+
+/// Loads and validates `file` with argument overrides ("speed" -> "0.5" from `speed:=0.5`),
+/// against the component types in runtime::ComponentRegistry.
+LoadResult load_graph(const std::string& file, const std::map<std::string, std::string>& args);
+
+}  // namespace avs::graph

@@ -1,0 +1,178 @@
+// The component contract (in the spirit of rclcpp_components): a component is a class
+// with a constructor taking a ComponentContext and a static spec() describing its
+// parameters and topics; AVS_REGISTER_COMPONENT puts it in the registry by type name.
+// The container chooses threads; the component only sees callbacks.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "avs/msg/type_registry.hpp"
+#include "avs/msg/type_support.hpp"
+#include "avs/runtime/logger.hpp"
+#include "avs/runtime/parameters.hpp"
+#include "avs/runtime/qos.hpp"
+#include "avs/runtime/sample.hpp"
+#include "avs/runtime/time.hpp"
+
+namespace avs::runtime {
+
+/// A topic a component publishes or subscribes to. `name` is the port (what remaps refer
+/// to); `default_topic` the ROS topic name used when not remapped (relative names get
+/// the graph's namespace).
+struct PortSpec {
+  std::string name;
+  std::string dds_type;
+  std::string default_topic;
+  QosProfile qos;
+};
+
+template <class T>
+PortSpec port(std::string name, std::string default_topic, QosProfile qos = {}) {
+  return {std::move(name), msg::TypeSupport<T>::dds_name, std::move(default_topic), qos};
+}
+
+struct ComponentSpec {
+  std::string type;
+  std::string description;
+  std::vector<ParamSpec> parameters;
+  std::vector<PortSpec> publishes;
+  std::vector<PortSpec> subscribes;
+
+  const ParamSpec* find_parameter(std::string_view name) const;
+  const PortSpec* find_port(std::string_view name) const;
+};
+
+/// Type-erased publishing end, implemented by the container.
+class PublisherCore {
+ public:
+  virtual ~PublisherCore() = default;
+  virtual void publish(std::shared_ptr<const void> sample) = 0;
+  virtual const std::string& topic() const = 0;
+};
+
+/// Publishes samples of T: components in the same container get the same shared sample
+/// (no copy); other processes get it over DDS.
+template <class T>
+class Publisher {
+ public:
+  Publisher() = default;
+  explicit Publisher(std::shared_ptr<PublisherCore> core) : core_(std::move(core)) {}
+  void publish(std::shared_ptr<const T> sample) const { core_->publish(std::move(sample)); }
+  const std::string& topic() const { return core_->topic(); }
+  explicit operator bool() const { return core_ != nullptr; }
+
+ private:
+  std::shared_ptr<PublisherCore> core_;
+};
+
+using TimerId = std::uint64_t;
+
+/// What a component gets from its container. Publishers and subscriptions are made for
+/// ports declared in the spec; timers run while the component is active.
+class ComponentContext {
+ public:
+  virtual ~ComponentContext() = default;
+
+  virtual const std::string& name() const = 0;
+  virtual const ParameterValues& parameters() const = 0;
+  virtual const Logger& log() const = 0;
+  /// Wall time, or simulated time when the graph runs in sim time.
+  virtual Time now() const = 0;
+  virtual bool uses_sim_time() const = 0;
+
+  /// Calls `callback` every `period` of the context's clock, on the component's thread.
+  virtual TimerId create_timer(Duration period, std::function<void()> callback) = 0;
+  virtual void cancel_timer(TimerId id) = 0;
+
+  template <class T>
+  T param(const std::string& name) const {
+    return parameters().template get<T>(name);
+  }
+
+  template <class T>
+  Publisher<T> publisher(std::string_view port) {
+    return Publisher<T>(make_publisher(port, type_entry<T>()));
+  }
+
+  /// `callback` runs on the component's thread with samples from this container
+  /// (shared, not copied) and from other processes.
+  template <class T>
+  void subscribe(std::string_view port, std::function<void(SamplePtr<T>)> callback) {
+    make_subscription(port, type_entry<T>(),
+                      [cb = std::move(callback)](std::shared_ptr<const void> sample) {
+                        cb(std::static_pointer_cast<const T>(std::move(sample)));
+                      });
+  }
+
+ protected:
+  virtual std::shared_ptr<PublisherCore> make_publisher(std::string_view port,
+                                                        const msg::TypeEntry& type) = 0;
+  virtual void make_subscription(std::string_view port, const msg::TypeEntry& type,
+                                 std::function<void(std::shared_ptr<const void>)> callback) = 0;
+
+ private:
+  template <class T>
+  static const msg::TypeEntry& type_entry() {
+    static const msg::TypeEntry entry{msg::TypeSupport<T>::dds_name,
+                                      msg::TypeSupport<T>::descriptor(), sizeof(T)};
+    return entry;
+  }
+};
+
+/// Base class of all components. Lifecycle: constructed (= configured, parameters read,
+/// publishers and subscriptions made) -> on_activate -> on_deactivate -> on_shutdown ->
+/// destroyed. Throwing from any step fails that component with the error reported.
+class Component {
+ public:
+  explicit Component(ComponentContext& context) : context_(context) {}
+  Component(const Component&) = delete;
+  Component& operator=(const Component&) = delete;
+  virtual ~Component() = default;
+
+  virtual void on_activate() {}
+  virtual void on_deactivate() {}
+  virtual void on_shutdown() {}
+
+ protected:
+  ComponentContext& context() { return context_; }
+  const Logger& log() const { return context_.log(); }
+
+ private:
+  ComponentContext& context_;
+};
+
+using ComponentFactory = std::function<std::unique_ptr<Component>(ComponentContext&)>;
+
+struct RegisteredComponent {
+  ComponentSpec spec;
+  ComponentFactory factory;
+};
+
+/// All component types linked into this program, by type name.
+class ComponentRegistry {
+ public:
+  static ComponentRegistry& instance();
+  void add(ComponentSpec spec, ComponentFactory factory);
+  const RegisteredComponent* find(std::string_view type) const;
+  std::vector<const RegisteredComponent*> all() const;
+
+ private:
+  std::vector<std::unique_ptr<RegisteredComponent>> entries_;
+};
+
+template <class C>
+bool register_component() {
+  ComponentRegistry::instance().add(
+      C::spec(), [](ComponentContext& ctx) { return std::make_unique<C>(ctx); });
+  return true;
+}
+
+}  // namespace avs::runtime
+
+/// Registers component class C (which has `static ComponentSpec spec()`). Use once, in C's .cpp.
+#define AVS_REGISTER_COMPONENT(C) \
+  [[maybe_unused]] static const bool avs_registered_##C = ::avs::runtime::register_component<C>()

@@ -1,0 +1,77 @@
+// Typed component parameters: declared statically with defaults, ranges and units,
+// validated from YAML before anything starts, read by the component at run time.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "avs/runtime/error.hpp"
+
+namespace avs::runtime {
+
+enum class ParamType { boolean, integer, real, string, real_list };
+
+using ParamValue = std::variant<bool, std::int64_t, double, std::string, std::vector<double>>;
+
+std::string to_string(ParamType type);
+std::string to_string(const ParamValue& value);
+ParamType type_of(const ParamValue& value);
+
+/// One declared parameter.
+struct ParamSpec {
+  std::string name;
+  ParamType type = ParamType::real;
+  ParamValue default_value;
+  std::optional<double> min;  ///< inclusive; numbers (and each list element) only
+  std::optional<double> max;  ///< inclusive
+  std::vector<std::string> choices;  ///< allowed values for strings, empty = any
+  std::string unit;                  ///< "Hz", "m", "rad", "" for none
+  std::string description;
+
+  static ParamSpec boolean(std::string name, bool def, std::string description);
+  static ParamSpec integer(std::string name, std::int64_t def, std::optional<double> min,
+                           std::optional<double> max, std::string unit, std::string description);
+  static ParamSpec real(std::string name, double def, std::optional<double> min,
+                        std::optional<double> max, std::string unit, std::string description);
+  static ParamSpec string(std::string name, std::string def, std::string description,
+                          std::vector<std::string> choices = {});
+  static ParamSpec real_list(std::string name, std::vector<double> def, std::string unit,
+                             std::string description);
+
+  /// Empty when `value` is acceptable; otherwise what was expected, e.g.
+  /// "expected a number in [0.1, 10000] Hz, got 0".
+  std::string check(const ParamValue& value) const;
+};
+
+/// Values of all declared parameters of one component instance, defaults filled in.
+class ParameterValues {
+ public:
+  void set(const std::string& name, ParamValue value) { values_[name] = std::move(value); }
+  bool contains(const std::string& name) const { return values_.count(name) != 0; }
+  const std::map<std::string, ParamValue>& all() const { return values_; }
+
+  template <class T>
+  T get(const std::string& name) const {
+    auto it = values_.find(name);
+    if (it == values_.end()) throw Error("parameter '" + name + "' was not declared");
+    if constexpr (std::is_same_v<T, int> || std::is_same_v<T, std::uint32_t>) {
+      return static_cast<T>(std::get<std::int64_t>(it->second));
+    } else if constexpr (std::is_same_v<T, float>) {
+      return static_cast<float>(std::get<double>(it->second));
+    } else {
+      if (!std::holds_alternative<T>(it->second)) {
+        throw Error("parameter '" + name + "' is a " + to_string(type_of(it->second)));
+      }
+      return std::get<T>(it->second);
+    }
+  }
+
+ private:
+  std::map<std::string, ParamValue> values_;
+};
+
+}  // namespace avs::runtime
