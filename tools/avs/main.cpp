@@ -1,7 +1,33 @@
 // avs: the command line. Subcommands live in their own files (launch.cpp, topic.cpp, ...).
-#include <cstdio>
+#include <iostream>
 
-int main() {
-  std::fprintf(stderr, "avs: not built yet\n");
-  return 1;
+#include "commands.hpp"
+
+namespace avs::cli {
+int& exit_status() {
+  static int status = 0;
+  return status;
+}
+}  // namespace avs::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{"avs: active high-speed 3-D vision (Gray-code depth at 500 Hz, visual servoing, "
+               "model matching) as a graph of components over DDS"};
+  app.require_subcommand(1);
+  avs::cli::add_demo_command(app);
+  avs::cli::add_launch_command(app);
+  avs::cli::add_check_command(app);
+  avs::cli::add_container_command(app);
+  avs::cli::add_components_command(app);
+  avs::cli::add_topic_command(app);
+  avs::cli::add_bench_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::cerr << "avs: " << e.what() << "\n";
+    return 1;
+  }
+  return avs::cli::exit_status();
 }

@@ -1,0 +1,64 @@
+// test_talker: publishes std_msgs/String "<seq> <address of this sample>" at a fixed rate,
+// and its sequence number as std_msgs/Float64 on a second port (a second type for tests).
+// Carrying its own address lets a listener prove it got the very same buffer (no copy).
+#include <cstdio>
+
+#include "avs/runtime/component.hpp"
+
+namespace avs::testing {
+
+using runtime::ComponentContext;
+using runtime::ComponentSpec;
+using runtime::ParamSpec;
+
+class TestTalker final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    return {.type = "test_talker",
+            .description = "publishes '<seq> <sample address>' strings at rate_hz",
+            .parameters = {ParamSpec::real("rate_hz", 100.0, 0.001, 100000.0, "Hz", "publishing rate"),
+                           ParamSpec::integer("count", 0, 0, std::nullopt, "",
+                                              "messages to send, 0 = until stopped")},
+            .publishes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter"),
+                          runtime::port<msgs::std_msgs::Float64>("count", "talker_count")},
+            .subscribes = {}};
+  }
+
+  explicit TestTalker(ComponentContext& ctx)
+      : Component(ctx),
+        chatter_(ctx.publisher<msgs::std_msgs::String>("chatter")),
+        count_topic_(ctx.publisher<msgs::std_msgs::Float64>("count")),
+        period_(static_cast<std::int64_t>(1e9 / ctx.param<double>("rate_hz"))),
+        count_(ctx.param<std::int64_t>("count")) {}
+
+  void on_activate() override {
+    timer_ = context().create_timer(period_, [this] { tick(); });
+  }
+  void on_deactivate() override { log().info("published ", seq_, " messages"); }
+
+ private:
+  void tick() {
+    if (count_ > 0 && seq_ >= static_cast<std::uint64_t>(count_)) return;
+    auto sample = runtime::make_sample<msgs::std_msgs::String>();
+    char text[64];
+    std::snprintf(text, sizeof text, "%llu %p", static_cast<unsigned long long>(seq_),
+                  static_cast<const void*>(sample.get()));
+    runtime::set_string(sample->data, text);
+    chatter_.publish(std::move(sample));
+    auto count = runtime::make_sample<msgs::std_msgs::Float64>();
+    count->data = static_cast<double>(seq_);
+    count_topic_.publish(std::move(count));
+    ++seq_;
+  }
+
+  runtime::Publisher<msgs::std_msgs::String> chatter_;
+  runtime::Publisher<msgs::std_msgs::Float64> count_topic_;
+  runtime::Duration period_;
+  std::int64_t count_;
+  std::uint64_t seq_ = 0;
+  runtime::TimerId timer_ = 0;
+};
+
+AVS_REGISTER_COMPONENT(TestTalker);
+
+}  // namespace avs::testing

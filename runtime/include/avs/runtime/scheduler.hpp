@@ -1,0 +1,90 @@
+// Runs the callbacks of a container's components on one or more threads ("lanes") and
+// owns the container's notion of time: wall time, or simulated time that is either
+// followed (from /clock), advanced in lockstep (as fast as possible, only when every lane
+// is idle, so results depend only on inputs), or advanced at a real-time factor.
+#pragma once
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <vector>
+
+#include "avs/runtime/time.hpp"
+
+namespace avs::runtime {
+
+enum class TimeMode { wall, sim_follower, sim_lockstep, sim_realtime };
+
+class Scheduler {
+ public:
+  using Callback = std::function<void()>;
+
+  explicit Scheduler(TimeMode mode, double real_time_factor = 1.0);
+  Scheduler(const Scheduler&) = delete;
+  Scheduler& operator=(const Scheduler&) = delete;
+
+  /// Adds a lane (one thread's queue) and returns its index. Call before run_lane().
+  int add_lane();
+
+  /// Queues `fn` on `lane`, FIFO. Thread-safe.
+  void post(int lane, Callback fn);
+
+  /// Calls `fn` on `lane` every `period`, first at now() + period. Thread-safe.
+  std::uint64_t add_timer(int lane, Duration period, Callback fn);
+  void cancel_timer(std::uint64_t id);
+
+  Time now() const;
+  TimeMode mode() const { return mode_; }
+
+  /// sim_follower: time received on /clock. Never goes backwards.
+  void set_sim_time(Time t);
+
+  /// Stops every lane once `end` is reached (sim or wall time).
+  void stop_at(Time end);
+
+  /// Called (outside the lock, on a lane thread) each time simulated time advances in
+  /// lockstep or realtime mode; the container publishes /clock from it.
+  void on_time_advanced(std::function<void(Time)> fn) { time_advanced_ = std::move(fn); }
+
+  /// Thread body: runs `lane`'s callbacks and timers until stop().
+  void run_lane(int lane);
+  void stop();
+  bool stopped() const;
+
+ private:
+  struct Timer {
+    int lane;
+    Duration period;
+    Callback fn;
+  };
+  struct Lane {
+    std::deque<Callback> queue;
+    bool idle = false;
+  };
+  using TimerKey = std::pair<std::int64_t, std::uint64_t>;  // (deadline ns, id)
+
+  Time now_locked() const;
+  bool all_idle_locked() const;
+  std::optional<TimerKey> next_timer_locked(int lane) const;
+  void wait_locked(std::unique_lock<std::mutex>& lock, int lane);
+
+  const TimeMode mode_;
+  const double real_time_factor_;
+  mutable std::mutex mutex_;
+  std::condition_variable changed_;
+  std::vector<Lane> lanes_;
+  std::map<TimerKey, Timer> timers_;
+  std::map<std::uint64_t, std::int64_t> timer_deadlines_;  // id -> deadline, for cancel
+  std::uint64_t next_timer_id_ = 1;
+  Time sim_now_{0};
+  std::int64_t steady_start_ns_ = 0;  // sim_realtime: wall origin
+  std::optional<Time> end_;
+  bool stopping_ = false;
+  std::function<void(Time)> time_advanced_;
+};
+
+}  // namespace avs::runtime

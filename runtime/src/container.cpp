@@ -1,0 +1,382 @@
+#include "avs/runtime/container.hpp"
+
+#include <iostream>
+#include <map>
+#include <mutex>
+
+#include "avs/runtime/dds.hpp"
+#include "avs/runtime/topic_name.hpp"
+#include "rosgraph_msgs.h"
+
+namespace avs::runtime {
+
+namespace {
+
+/// One sample callback of one component, already guarded (active check, exceptions).
+struct LocalSubscription {
+  int lane;
+  std::function<void(std::shared_ptr<const void>)> deliver;
+};
+
+/// Everything the container knows about one DDS topic.
+struct TopicEntry {
+  std::string dds_name;
+  const msg::TypeEntry* type = nullptr;
+  std::unique_ptr<dds::Topic> topic;
+  std::unique_ptr<dds::Writer> writer;
+  std::unique_ptr<dds::Reader> reader;
+  dds::Entity read_condition;
+  std::vector<LocalSubscription> subscriptions;  // fixed once the container runs
+};
+
+/// A sample of any registered type, allocated for dds_take and freed with its descriptor.
+std::shared_ptr<void> allocate_sample(const msg::TypeEntry& type) {
+  const dds_topic_descriptor_t* descriptor = type.descriptor;
+  return std::shared_ptr<void>(dds_alloc(type.sample_size), [descriptor](void* p) {
+    dds_sample_free(p, descriptor, DDS_FREE_ALL);
+  });
+}
+
+}  // namespace
+
+class ComponentHost;
+
+struct Container::Impl {
+  Impl(const graph::Graph& g, const graph::ContainerSpec& s);
+
+  TopicEntry& topic(const std::string& dds_name, const msg::TypeEntry& type, const QosProfile& qos);
+  void reader_loop();
+  void fail(const std::string& what);
+
+  const graph::Graph& graph;
+  const graph::ContainerSpec& spec;
+  Logger log;
+  dds::Participant participant;
+  std::unique_ptr<Scheduler> scheduler;
+  std::map<std::string, std::unique_ptr<TopicEntry>> topics;
+  std::vector<std::unique_ptr<ComponentHost>> hosts;
+  std::atomic<bool> failed{false};
+  std::atomic<bool> running{false};
+  std::unique_ptr<dds::WaitSet> waitset;
+  std::unique_ptr<dds::Writer> clock_writer;
+  std::unique_ptr<dds::Topic> clock_topic;
+  std::vector<TopicEntry*> read_topics;  // waitset attach token = index
+  TopicEntry* clock_follow = nullptr;
+};
+
+namespace {
+
+TimeMode time_mode_for(const graph::Graph& g, const graph::ContainerSpec& s) {
+  if (g.clock.source == graph::ClockSpec::Source::wall) return TimeMode::wall;
+  const std::string master = g.clock.master.empty() && !g.containers.empty()
+                                 ? g.containers.front().name
+                                 : g.clock.master;
+  if (s.name != master) return TimeMode::sim_follower;
+  return g.clock.mode == graph::ClockSpec::Mode::lockstep ? TimeMode::sim_lockstep
+                                                          : TimeMode::sim_realtime;
+}
+
+}  // namespace
+
+/// The ComponentContext a component sees: its parameters, ports, timers and clock.
+class ComponentHost final : public ComponentContext {
+ public:
+  ComponentHost(Container::Impl& container, const graph::ComponentInstance& instance,
+                const RegisteredComponent& registered, int lane)
+      : container_(container),
+        instance_(instance),
+        registered_(registered),
+        lane_(lane),
+        log_(instance.name) {}
+
+  const std::string& name() const override { return instance_.name; }
+  const ParameterValues& parameters() const override { return instance_.parameters; }
+  const Logger& log() const override { return log_; }
+  Time now() const override { return container_.scheduler->now(); }
+  bool uses_sim_time() const override { return container_.scheduler->mode() != TimeMode::wall; }
+
+  TimerId create_timer(Duration period, std::function<void()> callback) override {
+    const TimerId id = container_.scheduler->add_timer(lane_, period, guard(std::move(callback)));
+    std::lock_guard lock(timers_mutex_);
+    timers_.push_back(id);
+    return id;
+  }
+
+  void cancel_timer(TimerId id) override { container_.scheduler->cancel_timer(id); }
+
+  void cancel_all_timers() {
+    std::lock_guard lock(timers_mutex_);
+    for (TimerId id : timers_) container_.scheduler->cancel_timer(id);
+    timers_.clear();
+  }
+
+  void set_active(bool active) { active_ = active; }
+  const graph::ComponentInstance& instance() const { return instance_; }
+  std::unique_ptr<Component> component;
+
+ protected:
+  std::shared_ptr<PublisherCore> make_publisher(std::string_view port,
+                                                const msg::TypeEntry& type) override;
+  void make_subscription(std::string_view port, const msg::TypeEntry& type,
+                         std::function<void(std::shared_ptr<const void>)> callback) override;
+
+ private:
+  /// Runs `fn` only while active; an exception fails the container with context.
+  std::function<void()> guard(std::function<void()> fn) {
+    return [this, fn = std::move(fn)] {
+      if (!active_) return;
+      try {
+        fn();
+      } catch (const std::exception& e) {
+        container_.fail("component '" + instance_.name + "' (" + instance_.type +
+                        "): callback failed: " + e.what());
+      }
+    };
+  }
+
+  /// Port -> (DDS topic name, QoS), after remaps and the graph's namespace.
+  std::pair<std::string, QosProfile> resolve(std::string_view port, const msg::TypeEntry& type,
+                                             bool publishing) const {
+    const auto& ports = publishing ? registered_.spec.publishes : registered_.spec.subscribes;
+    const PortSpec* found = nullptr;
+    for (const auto& p : ports) {
+      if (p.name == port) found = &p;
+    }
+    const std::string what = std::string(publishing ? "publisher" : "subscription") + " port '" +
+                             std::string(port) + "' of component '" + instance_.name + "'";
+    if (found == nullptr) throw Error(what + " is not declared in the spec of " + instance_.type);
+    if (found->dds_type != type.dds_name) {
+      throw Error(what + " is declared as " + found->dds_type + " but used as " + type.dds_name);
+    }
+    const auto remap = instance_.remaps.find(found->name);
+    const std::string ros_name = resolve_topic_name(
+        container_.graph.ns, remap != instance_.remaps.end() ? remap->second : found->default_topic);
+    const auto qos = instance_.qos.find(found->name);
+    return {to_dds_topic_name(ros_name), qos != instance_.qos.end() ? qos->second : found->qos};
+  }
+
+  Container::Impl& container_;
+  const graph::ComponentInstance& instance_;
+  const RegisteredComponent& registered_;
+  const int lane_;
+  Logger log_;
+  std::atomic<bool> active_{false};
+  std::mutex timers_mutex_;
+  std::vector<TimerId> timers_;
+};
+
+namespace {
+
+class LocalPublisher final : public PublisherCore {
+ public:
+  LocalPublisher(Scheduler& scheduler, TopicEntry& topic) : scheduler_(scheduler), topic_(topic) {}
+
+  void publish(std::shared_ptr<const void> sample) override {
+    for (const auto& sub : topic_.subscriptions) {
+      scheduler_.post(sub.lane, [deliver = sub.deliver, sample] { deliver(sample); });
+    }
+    // Serialise only when a reader in another participant wants it.
+    if (topic_.writer->matched_readers() > 0) topic_.writer->write(sample.get());
+  }
+  const std::string& topic() const override { return topic_.dds_name; }
+
+ private:
+  Scheduler& scheduler_;
+  TopicEntry& topic_;
+};
+
+}  // namespace
+
+std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view port,
+                                                             const msg::TypeEntry& type) {
+  if (container_.running) throw Error("publishers must be created in the constructor");
+  auto [dds_name, qos] = resolve(port, type, true);
+  TopicEntry& topic = container_.topic(dds_name, type, qos);
+  if (!topic.writer) topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
+  return std::make_shared<LocalPublisher>(*container_.scheduler, topic);
+}
+
+void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntry& type,
+                                      std::function<void(std::shared_ptr<const void>)> callback) {
+  if (container_.running) throw Error("subscriptions must be created in the constructor");
+  auto [dds_name, qos] = resolve(port, type, false);
+  TopicEntry& topic = container_.topic(dds_name, type, qos);
+  if (!topic.reader) topic.reader = std::make_unique<dds::Reader>(container_.participant, *topic.topic, qos);
+  topic.subscriptions.push_back(
+      {lane_, [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
+         guard([&] { cb(std::move(sample)); })();
+       }});
+}
+
+Container::Impl::Impl(const graph::Graph& g, const graph::ContainerSpec& s)
+    : graph(g), spec(s), log("container/" + s.name), participant(g.domain_id) {
+  scheduler = std::make_unique<Scheduler>(time_mode_for(g, s), g.clock.real_time_factor);
+}
+
+TopicEntry& Container::Impl::topic(const std::string& dds_name, const msg::TypeEntry& type,
+                                   const QosProfile& qos) {
+  auto& slot = topics[dds_name];
+  if (!slot) {
+    slot = std::make_unique<TopicEntry>();
+    slot->dds_name = dds_name;
+    slot->type = &type;
+    slot->topic = std::make_unique<dds::Topic>(participant, type.descriptor, dds_name, qos);
+  } else if (slot->type->descriptor != type.descriptor) {
+    throw Error("topic " + dds_name + " used with two types: " + slot->type->dds_name + " and " +
+                type.dds_name);
+  }
+  return *slot;
+}
+
+void Container::Impl::fail(const std::string& what) {
+  log.error(what);
+  failed = true;
+  scheduler->stop();
+}
+
+void Container::Impl::reader_loop() {
+  std::vector<dds_attach_t> triggered(read_topics.size() + 1);
+  while (!scheduler->stopped()) {
+    int n = 0;
+    try {
+      n = waitset->wait(triggered.data(), triggered.size(), DDS_MSECS(100));
+    } catch (const std::exception& e) {
+      fail(std::string("DDS wait failed: ") + e.what());
+      return;
+    }
+    for (int i = 0; i < n; ++i) {
+      if (triggered[static_cast<std::size_t>(i)] == 0) continue;  // the guard condition
+      TopicEntry& topic = *read_topics[static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)] - 1)];
+      for (;;) {
+        std::shared_ptr<void> sample = allocate_sample(*topic.type);
+        void* buffers[1] = {sample.get()};
+        dds_sample_info_t info;
+        const dds_return_t taken = dds_take(topic.reader->get(), buffers, &info, 1, 1);
+        if (taken <= 0) break;
+        if (!info.valid_data) continue;
+        if (&topic == clock_follow) {
+          const auto* clock = static_cast<const rosgraph_msgs_msg_dds__Clock_*>(sample.get());
+          scheduler->set_sim_time(from_ros_time(clock->clock));
+        }
+        for (const auto& sub : topic.subscriptions) {
+          scheduler->post(sub.lane, [deliver = sub.deliver, sample] { deliver(sample); });
+        }
+      }
+    }
+  }
+}
+
+Container::Container(const graph::Graph& graph, const graph::ContainerSpec& spec)
+    : graph_(graph), spec_(spec), impl_(std::make_unique<Impl>(graph, spec)) {}
+
+Container::~Container() = default;
+
+void Container::stop() { impl_->scheduler->stop(); }
+
+Component* Container::find_component(const std::string& name) const {
+  for (const auto& host : impl_->hosts) {
+    if (host->instance().name == name) return host->component.get();
+  }
+  return nullptr;
+}
+
+int Container::run() {
+  Impl& c = *impl_;
+  Scheduler& scheduler = *c.scheduler;
+  const bool per_component = spec_.executor == graph::ExecutorKind::thread_per_component;
+  const int lane_count = per_component ? static_cast<int>(spec_.components.size()) : 1;
+  for (int i = 0; i < std::max(lane_count, 1); ++i) scheduler.add_lane();
+
+  // Configure: construct every component (parameters read, ports made).
+  int index = 0;
+  for (const auto& instance : spec_.components) {
+    const RegisteredComponent* registered = ComponentRegistry::instance().find(instance.type);
+    if (registered == nullptr) {
+      c.log.error("component '", instance.name, "': unknown type '", instance.type, "'");
+      return 1;
+    }
+    auto host = std::make_unique<ComponentHost>(c, instance, *registered, per_component ? index : 0);
+    try {
+      host->component = registered->factory(*host);
+    } catch (const std::exception& e) {
+      c.log.error("component '", instance.name, "' (", instance.type, ") failed to load: ", e.what());
+      return 1;
+    }
+    c.hosts.push_back(std::move(host));
+    ++index;
+  }
+
+  // Clock: the master publishes /clock, followers listen to it.
+  const TimeMode mode = scheduler.mode();
+  const msg::TypeEntry* clock_type = msg::find_type("rosgraph_msgs::msg::dds_::Clock_");
+  const QosProfile clock_qos = *QosProfile::named("clock");
+  if (mode == TimeMode::sim_lockstep || mode == TimeMode::sim_realtime) {
+    c.clock_topic = std::make_unique<dds::Topic>(c.participant, clock_type->descriptor, "rt/clock", clock_qos);
+    c.clock_writer = std::make_unique<dds::Writer>(c.participant, *c.clock_topic, clock_qos);
+    scheduler.on_time_advanced([&c](Time t) {
+      rosgraph_msgs_msg_dds__Clock_ sample{};
+      to_ros_time(t, sample.clock);
+      if (c.clock_writer->matched_readers() > 0) c.clock_writer->write(&sample);
+    });
+  } else if (mode == TimeMode::sim_follower) {
+    TopicEntry& topic = c.topic("rt/clock", *clock_type, clock_qos);
+    if (!topic.reader) topic.reader = std::make_unique<dds::Reader>(c.participant, *topic.topic, clock_qos);
+    c.clock_follow = &topic;
+  }
+
+  // DDS inputs from other processes.
+  c.waitset = std::make_unique<dds::WaitSet>(c.participant);
+  for (auto& [name, topic] : c.topics) {
+    if (!topic->reader) continue;
+    c.read_topics.push_back(topic.get());
+    topic->read_condition = dds::Entity(check_dds(
+        dds_create_readcondition(topic->reader->get(), DDS_ANY_STATE), "read condition on " + name));
+    c.waitset->attach(topic->read_condition.get(), static_cast<dds_attach_t>(c.read_topics.size()));
+  }
+
+  // Activate.
+  c.running = true;
+  for (auto& host : c.hosts) {
+    try {
+      host->set_active(true);
+      host->component->on_activate();
+    } catch (const std::exception& e) {
+      c.fail("component '" + host->instance().name + "' failed to activate: " + e.what());
+      break;
+    }
+  }
+  if (graph_.clock.duration_s && *graph_.clock.duration_s > 0) {
+    const Time start = mode == TimeMode::wall ? scheduler.now() : Time{0};
+    scheduler.stop_at(start + Duration(static_cast<std::int64_t>(*graph_.clock.duration_s * 1e9)));
+  }
+  c.log.info("running ", c.hosts.size(), " component(s) on ", lane_count, " thread(s), ",
+             mode == TimeMode::wall ? "wall time" : "sim time");
+
+  {
+    std::thread reader([&c] { c.reader_loop(); });
+    std::vector<std::thread> lanes;
+    for (int i = 0; i < lane_count; ++i) lanes.emplace_back([&scheduler, i] { scheduler.run_lane(i); });
+    for (auto& t : lanes) t.join();
+    scheduler.stop();
+    c.waitset->wake();
+    reader.join();
+  }
+
+  // Deactivate and shut down in reverse order; DDS entities go with the participant.
+  for (auto it = c.hosts.rbegin(); it != c.hosts.rend(); ++it) {
+    auto& host = **it;
+    host.set_active(false);
+    host.cancel_all_timers();
+    try {
+      host.component->on_deactivate();
+      host.component->on_shutdown();
+    } catch (const std::exception& e) {
+      c.log.error("component '", host.instance().name, "' failed to shut down: ", e.what());
+      c.failed = true;
+    }
+  }
+  c.log.info(c.failed ? "stopped after a failure" : "stopped");
+  return c.failed ? 1 : 0;
+}
+
+}  // namespace avs::runtime

@@ -1,0 +1,68 @@
+#include "avs/runtime/dds.hpp"
+
+namespace avs::runtime::dds {
+
+Participant::Participant(dds_domainid_t domain)
+    : Entity(check_dds(dds_create_participant(domain, nullptr, nullptr),
+                       "create DDS participant on domain " + std::to_string(domain))) {}
+
+Topic::Topic(const Participant& participant, const dds_topic_descriptor_t* descriptor,
+             const std::string& name, const QosProfile& qos)
+    : Entity(check_dds(dds_create_topic(participant.get(), descriptor, name.c_str(),
+                                        Qos(qos).get(), nullptr),
+                       "create topic " + name + " (" + descriptor->m_typename + ")")),
+      name_(name) {}
+
+namespace {
+Qos endpoint_qos(const QosProfile& profile) {
+  Qos qos(profile);
+  // In-process delivery is done by the container without copies; DDS serves the others.
+  dds_qset_ignorelocal(qos.get(), DDS_IGNORELOCAL_PARTICIPANT);
+  return qos;
+}
+}  // namespace
+
+Writer::Writer(const Participant& participant, const Topic& topic, const QosProfile& qos)
+    : Entity(check_dds(dds_create_writer(participant.get(), topic.get(), endpoint_qos(qos).get(),
+                                         nullptr),
+                       "create writer on " + topic.name())),
+      topic_name_(topic.name()) {}
+
+void Writer::write(const void* sample) { check_dds(dds_write(get(), sample), "write to " + topic_name_); }
+
+std::uint32_t Writer::matched_readers() const {
+  dds_publication_matched_status_t status{};
+  check_dds(dds_get_publication_matched_status(get(), &status), "matched status of " + topic_name_);
+  return status.current_count;
+}
+
+Reader::Reader(const Participant& participant, const Topic& topic, const QosProfile& qos)
+    : Entity(check_dds(dds_create_reader(participant.get(), topic.get(), endpoint_qos(qos).get(),
+                                         nullptr),
+                       "create reader on " + topic.name())),
+      topic_name_(topic.name()) {}
+
+WaitSet::WaitSet(const Participant& participant)
+    : Entity(check_dds(dds_create_waitset(participant.get()), "create waitset")),
+      guard_(check_dds(dds_create_guardcondition(participant.get()), "create guard condition")) {
+  attach(guard_.get(), 0);
+}
+
+void WaitSet::attach(dds_entity_t entity, dds_attach_t token) {
+  check_dds(dds_waitset_attach(get(), entity, token), "attach to waitset");
+}
+
+void WaitSet::detach(dds_entity_t entity) {
+  check_dds(dds_waitset_detach(get(), entity), "detach from waitset");
+}
+
+int WaitSet::wait(dds_attach_t* triggered, std::size_t capacity, dds_duration_t timeout) {
+  const dds_return_t n = check_dds(dds_waitset_wait(get(), triggered, capacity, timeout), "wait");
+  bool woken = false;
+  check_dds(dds_take_guardcondition(guard_.get(), &woken), "reset guard condition");
+  return n;
+}
+
+void WaitSet::wake() { check_dds(dds_set_guardcondition(guard_.get(), true), "wake waitset"); }
+
+}  // namespace avs::runtime::dds

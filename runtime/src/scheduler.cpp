@@ -1,0 +1,227 @@
+#include "avs/runtime/scheduler.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include "avs/runtime/error.hpp"
+
+namespace avs::runtime {
+
+namespace {
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+std::int64_t system_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+}  // namespace
+
+Scheduler::Scheduler(TimeMode mode, double real_time_factor)
+    : mode_(mode), real_time_factor_(real_time_factor), steady_start_ns_(steady_ns()) {
+  if (mode == TimeMode::sim_realtime && !(real_time_factor > 0)) {
+    throw Error("real_time_factor must be > 0, got " + std::to_string(real_time_factor));
+  }
+}
+
+int Scheduler::add_lane() {
+  std::lock_guard lock(mutex_);
+  lanes_.emplace_back();
+  return static_cast<int>(lanes_.size()) - 1;
+}
+
+void Scheduler::post(int lane, Callback fn) {
+  {
+    std::lock_guard lock(mutex_);
+    lanes_.at(static_cast<std::size_t>(lane)).queue.push_back(std::move(fn));
+  }
+  changed_.notify_all();
+}
+
+std::uint64_t Scheduler::add_timer(int lane, Duration period, Callback fn) {
+  if (period.count() <= 0) throw Error("timer period must be positive");
+  std::uint64_t id;
+  {
+    std::lock_guard lock(mutex_);
+    id = next_timer_id_++;
+    const std::int64_t deadline = (now_locked() + period).ns;
+    timers_.emplace(TimerKey{deadline, id}, Timer{lane, period, std::move(fn)});
+    timer_deadlines_[id] = deadline;
+  }
+  changed_.notify_all();
+  return id;
+}
+
+void Scheduler::cancel_timer(std::uint64_t id) {
+  std::lock_guard lock(mutex_);
+  auto it = timer_deadlines_.find(id);
+  if (it == timer_deadlines_.end()) return;
+  timers_.erase(TimerKey{it->second, id});
+  timer_deadlines_.erase(it);
+}
+
+Time Scheduler::now() const {
+  std::lock_guard lock(mutex_);
+  return now_locked();
+}
+
+Time Scheduler::now_locked() const {
+  switch (mode_) {
+    case TimeMode::wall:
+      return {system_ns()};
+    case TimeMode::sim_realtime: {
+      const double elapsed = static_cast<double>(steady_ns() - steady_start_ns_);
+      return {static_cast<std::int64_t>(elapsed * real_time_factor_)};
+    }
+    case TimeMode::sim_follower:
+    case TimeMode::sim_lockstep:
+      return sim_now_;
+  }
+  return sim_now_;
+}
+
+void Scheduler::set_sim_time(Time t) {
+  {
+    std::lock_guard lock(mutex_);
+    if (t <= sim_now_) return;
+    sim_now_ = t;
+  }
+  changed_.notify_all();
+}
+
+void Scheduler::stop_at(Time end) {
+  {
+    std::lock_guard lock(mutex_);
+    end_ = end;
+  }
+  changed_.notify_all();
+}
+
+void Scheduler::stop() {
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  changed_.notify_all();
+}
+
+bool Scheduler::stopped() const {
+  std::lock_guard lock(mutex_);
+  return stopping_;
+}
+
+std::optional<Scheduler::TimerKey> Scheduler::next_timer_locked(int lane) const {
+  for (const auto& [key, timer] : timers_) {
+    if (timer.lane == lane) return key;
+  }
+  return std::nullopt;
+}
+
+bool Scheduler::all_idle_locked() const {
+  for (const auto& lane : lanes_) {
+    if (!lane.idle || !lane.queue.empty()) return false;
+  }
+  return timers_.empty() || timers_.begin()->first.first > sim_now_.ns;
+}
+
+void Scheduler::run_lane(int lane_index) {
+  std::unique_lock lock(mutex_);
+  Lane& lane = lanes_.at(static_cast<std::size_t>(lane_index));
+  while (!stopping_) {
+    if (end_ && now_locked() >= *end_) {
+      stopping_ = true;
+      changed_.notify_all();
+      break;
+    }
+    if (!lane.queue.empty()) {
+      Callback fn = std::move(lane.queue.front());
+      lane.queue.pop_front();
+      lock.unlock();
+      fn();
+      lock.lock();
+      continue;
+    }
+    const auto next = next_timer_locked(lane_index);
+    const Time now = now_locked();
+    if (next && next->first <= now.ns) {
+      auto node = timers_.extract(*next);
+      Timer& timer = node.mapped();
+      // Next deadline on the period grid; in wall time, skip slots already missed.
+      std::int64_t deadline = next->first + timer.period.count();
+      if (deadline <= now.ns && mode_ != TimeMode::sim_lockstep) {
+        const std::int64_t missed = (now.ns - deadline) / timer.period.count() + 1;
+        deadline += missed * timer.period.count();
+      }
+      Callback fn = timer.fn;  // copy: the timer may be cancelled while fn runs
+      const std::uint64_t id = next->second;
+      timers_.emplace(TimerKey{deadline, id}, std::move(timer));
+      timer_deadlines_[id] = deadline;
+      lock.unlock();
+      fn();
+      lock.lock();
+      continue;
+    }
+    wait_locked(lock, lane_index);
+  }
+}
+
+void Scheduler::wait_locked(std::unique_lock<std::mutex>& lock, int lane_index) {
+  Lane& lane = lanes_.at(static_cast<std::size_t>(lane_index));
+  lane.idle = true;
+  const auto next = next_timer_locked(lane_index);
+  switch (mode_) {
+    case TimeMode::wall: {
+      if (next) {
+        const auto deadline = std::chrono::system_clock::time_point(
+            std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                std::chrono::nanoseconds(next->first)));
+        changed_.wait_until(lock, deadline);
+      } else {
+        changed_.wait_for(lock, std::chrono::milliseconds(100));
+      }
+      break;
+    }
+    case TimeMode::sim_realtime: {
+      const std::int64_t target =
+          next ? next->first : (now_locked() + std::chrono::milliseconds(1)).ns;
+      const auto wake = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(
+          steady_start_ns_ + static_cast<std::int64_t>(static_cast<double>(target) /
+                                                       real_time_factor_)));
+      changed_.wait_until(lock, wake);
+      const Time t = now_locked();
+      if (time_advanced_) {
+        lock.unlock();
+        time_advanced_(t);
+        lock.lock();
+      }
+      break;
+    }
+    case TimeMode::sim_follower:
+      changed_.wait_for(lock, std::chrono::milliseconds(100));
+      break;
+    case TimeMode::sim_lockstep: {
+      if (all_idle_locked() && !timers_.empty()) {
+        // Every lane is idle and nothing is due: jump to the earliest deadline.
+        Time t{timers_.begin()->first.first};
+        if (end_ && t > *end_) t = *end_;
+        sim_now_ = t;
+        changed_.notify_all();
+        if (time_advanced_) {
+          lane.idle = false;
+          lock.unlock();
+          time_advanced_(t);
+          lock.lock();
+        }
+      } else {
+        changed_.wait_for(lock, std::chrono::milliseconds(100));
+      }
+      break;
+    }
+  }
+  lane.idle = false;
+}
+
+}  // namespace avs::runtime

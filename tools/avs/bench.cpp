@@ -1,0 +1,70 @@
+// avs bench [NAME [--json] [ARGS...]]: runs a registered benchmark and prints ours beside
+// the peer measured in the same run, or one JSON object with unit-carrying keys.
+#include <cstdio>
+#include <iostream>
+
+#include "avs/bench/report.hpp"
+#include "commands.hpp"
+
+namespace avs::cli {
+
+namespace {
+
+void print_table(const bench::Report& report) {
+  std::printf("%s\n\n", report.title.c_str());
+  std::printf("%-48s %12s   %-34s %12s %9s\n", "measure", "avs", "peer", "peer", "ratio");
+  for (const auto& row : report.rows) {
+    if (row.peer_name.empty()) {
+      std::printf("%-48s %9.4f %-2s\n", row.what.c_str(), row.ours, row.unit.c_str());
+    } else {
+      std::printf("%-48s %9.4f %-2s   %-34s %9.4f %-2s %8.1fx\n", row.what.c_str(), row.ours,
+                  row.unit.c_str(), row.peer_name.c_str(), row.peer, row.unit.c_str(),
+                  row.ours > 0 ? row.peer / row.ours : 0.0);
+    }
+  }
+  for (const auto& note : report.notes) std::printf("\n%s", note.c_str());
+  std::printf("\n");
+}
+
+void print_json(const bench::Report& report) {
+  std::printf("{");
+  bool first = true;
+  for (const auto& [key, value] : report.json) {
+    std::printf("%s\"%s\": %.6g", first ? "" : ", ", key.c_str(), value);
+    first = false;
+  }
+  std::printf("}\n");
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("bench", "Benchmarks against a peer measured in the same run");
+  static std::string name;
+  static bool json = false;
+  static std::vector<std::string> args;
+  cmd->add_option("name", name, "benchmark name (omit to list them)");
+  cmd->add_flag("--json", json, "print one JSON object (keys carry units)");
+  cmd->add_option("args", args, "arguments for the benchmark (e.g. --model FILE)");
+  cmd->allow_extras();
+  cmd->callback([cmd] {
+    auto extras = cmd->remaining();
+    args.insert(args.end(), extras.begin(), extras.end());
+    if (name.empty()) {
+      for (const auto& b : bench::bench_registry()) {
+        std::printf("%-12s %s\n", b.name.c_str(), b.description.c_str());
+      }
+      return;
+    }
+    for (const auto& b : bench::bench_registry()) {
+      if (b.name != name) continue;
+      const bench::Report report = b.run(args);
+      json ? print_json(report) : print_table(report);
+      return;
+    }
+    std::cerr << "avs bench: no benchmark '" << name << "' (run `avs bench` to list them)\n";
+    exit_status() = 2;
+  });
+}
+
+}  // namespace avs::cli

@@ -1,0 +1,324 @@
+// avs topic list | echo | hz | bw: inspect a running graph from any process, through DDS
+// discovery (built-in topics) and raw CDR samples of any type this build knows.
+#include <dds/ddsi/ddsi_serdata.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <iostream>
+#include <map>
+#include <set>
+#include <thread>
+
+#include "avs/introspection/cdr_reader.hpp"
+#include "avs/introspection/type_database.hpp"
+#include "avs/msg/type_registry.hpp"
+#include "avs/runtime/dds.hpp"
+#include "avs/runtime/topic_name.hpp"
+#include "commands.hpp"
+
+namespace avs::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct EndpointInfo {
+  std::string type_name;
+  std::string qos;
+};
+
+struct TopicInfo {
+  std::string type_name;
+  std::vector<EndpointInfo> publishers;
+  std::vector<EndpointInfo> subscribers;
+};
+
+std::string describe_qos(const dds_qos_t* qos) {
+  std::string s;
+  dds_reliability_kind_t reliability;
+  dds_duration_t blocking;
+  if (dds_qget_reliability(qos, &reliability, &blocking)) {
+    s += reliability == DDS_RELIABILITY_RELIABLE ? "reliable" : "best_effort";
+  }
+  dds_durability_kind_t durability;
+  if (dds_qget_durability(qos, &durability)) {
+    s += durability == DDS_DURABILITY_VOLATILE ? ", volatile" : ", transient_local";
+  }
+  dds_history_kind_t history;
+  int32_t depth = 0;
+  if (dds_qget_history(qos, &history, &depth)) {
+    s += history == DDS_HISTORY_KEEP_LAST ? ", keep_last " + std::to_string(depth) : ", keep_all";
+  }
+  dds_duration_t deadline;
+  if (dds_qget_deadline(qos, &deadline) && deadline != DDS_INFINITY) {
+    s += ", deadline " + std::to_string(deadline / 1000) + " us";
+  }
+  return s;
+}
+
+volatile std::sig_atomic_t g_interrupted = 0;
+void on_interrupt(int) { g_interrupted = 1; }
+
+/// Reads the built-in publication/subscription topics for `wait`, skipping our own.
+std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& participant,
+                                          std::chrono::milliseconds wait) {
+  runtime::dds::Entity pubs(runtime::check_dds(
+      dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
+      "read DCPSPublication"));
+  runtime::dds::Entity subs(runtime::check_dds(
+      dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr),
+      "read DCPSSubscription"));
+  std::this_thread::sleep_for(wait);
+  dds_guid_t own{};
+  runtime::check_dds(dds_get_guid(participant.get(), &own), "participant guid");
+
+  std::map<std::string, TopicInfo> topics;
+  for (int kind = 0; kind < 2; ++kind) {
+    const dds_entity_t reader = kind == 0 ? pubs.get() : subs.get();
+    void* samples[256] = {};
+    dds_sample_info_t infos[256];
+    const int n = runtime::check_dds(dds_read(reader, samples, infos, 256, 256), "read discovery");
+    for (int i = 0; i < n; ++i) {
+      if (!infos[i].valid_data || infos[i].instance_state != DDS_IST_ALIVE) continue;
+      const auto* ep = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
+      if (std::equal(std::begin(ep->participant_key.v), std::end(ep->participant_key.v),
+                     std::begin(own.v))) {
+        continue;
+      }
+      const std::string topic = ep->topic_name;
+      if (topic.rfind("DCPS", 0) == 0) continue;
+      TopicInfo& info = topics[topic];
+      info.type_name = ep->type_name;
+      (kind == 0 ? info.publishers : info.subscribers).push_back({ep->type_name, describe_qos(ep->qos)});
+    }
+    dds_return_loan(reader, samples, n);
+  }
+  return topics;
+}
+
+/// Accepts "rt/depth", "/depth" or "depth".
+std::string dds_topic_of(const std::string& name) {
+  if (name.rfind("rt/", 0) == 0) return name;
+  return runtime::to_dds_topic_name(runtime::resolve_topic_name("/", name));
+}
+
+/// A reader of raw CDR on a topic of any known type, found through discovery.
+class RawReader {
+ public:
+  RawReader(const runtime::dds::Participant& participant, const std::string& topic_arg,
+            double wait_s)
+      : dds_name_(dds_topic_of(topic_arg)) {
+    const auto deadline = Clock::now() + std::chrono::duration<double>(wait_s);
+    std::map<std::string, TopicInfo> topics;
+    while (true) {
+      topics = discover(participant, std::chrono::milliseconds(300));
+      auto it = topics.find(dds_name_);
+      if (it != topics.end() && !it->second.publishers.empty()) break;
+      if (Clock::now() > deadline) {
+        throw runtime::Error("no publisher of " + dds_name_ + " found within " +
+                             std::to_string(wait_s) + " s (see `avs topic list`)");
+      }
+    }
+    const TopicInfo& info = topics.at(dds_name_);
+    type_ = msg::find_type(info.type_name);
+    if (type_ == nullptr) {
+      throw runtime::Error(dds_name_ + " has type " + info.type_name + ", which this build does not know");
+    }
+    // Match what the publishers offer: reliable only if they all are.
+    runtime::QosProfile qos;
+    qos.depth = 256;
+    for (const auto& p : info.publishers) {
+      if (p.qos.rfind("best_effort", 0) == 0) qos.reliability = runtime::Reliability::best_effort;
+    }
+    topic_ = std::make_unique<runtime::dds::Topic>(participant, type_->descriptor, dds_name_, qos);
+    runtime::Qos reader_qos(qos);
+    reader_ = runtime::dds::Entity(runtime::check_dds(
+        dds_create_reader(participant.get(), topic_->get(), reader_qos.get(), nullptr),
+        "create reader on " + dds_name_));
+    waitset_ = runtime::dds::Entity(runtime::check_dds(dds_create_waitset(participant.get()), "waitset"));
+    condition_ = runtime::dds::Entity(runtime::check_dds(
+        dds_create_readcondition(reader_.get(), DDS_ANY_STATE), "read condition"));
+    runtime::check_dds(dds_waitset_attach(waitset_.get(), condition_.get(), 0), "attach");
+  }
+
+  /// Waits up to `timeout` and calls `fn(bytes, info)` for each sample taken.
+  template <class Fn>
+  void take(std::chrono::milliseconds timeout, Fn&& fn) {
+    dds_waitset_wait(waitset_.get(), nullptr, 0, DDS_MSECS(timeout.count()));
+    for (;;) {
+      ddsi_serdata* data = nullptr;
+      dds_sample_info_t info;
+      if (dds_takecdr(reader_.get(), &data, 1, &info, DDS_ANY_STATE) <= 0) break;
+      if (info.valid_data) {
+        const std::size_t size = ddsi_serdata_size(data);
+        buffer_.resize(size);
+        ddsi_serdata_to_ser(data, 0, size, buffer_.data());
+        fn(std::span<const std::uint8_t>(buffer_), info);
+      }
+      ddsi_serdata_unref(data);
+    }
+  }
+
+  const msg::TypeEntry& type() const { return *type_; }
+  const std::string& dds_name() const { return dds_name_; }
+
+ private:
+  std::string dds_name_;
+  const msg::TypeEntry* type_ = nullptr;
+  std::unique_ptr<runtime::dds::Topic> topic_;
+  runtime::dds::Entity reader_, waitset_, condition_;
+  std::vector<std::uint8_t> buffer_;
+};
+
+struct CommonOptions {
+  std::string topic;
+  int domain = 0;
+  double wait_s = 5.0;
+  double duration_s = 0;  // 0 = until Ctrl-C
+  long count = 0;         // 0 = unlimited
+};
+
+void add_common(CLI::App* cmd, CommonOptions& o, bool needs_topic) {
+  if (needs_topic) cmd->add_option("topic", o.topic, "topic: /name, name or rt/name")->required();
+  cmd->add_option("--domain", o.domain, "DDS domain id")->capture_default_str();
+  cmd->add_option("--wait", o.wait_s, "seconds to wait for a publisher")->capture_default_str();
+  cmd->add_option("--duration", o.duration_s, "stop after this many seconds (0: until Ctrl-C)");
+}
+
+bool should_stop(const CommonOptions& o, Clock::time_point start) {
+  if (g_interrupted) return true;
+  return o.duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(o.duration_s);
+}
+
+void run_list(const CommonOptions& o, bool verbose) {
+  runtime::dds::Participant participant(o.domain);
+  const auto topics = discover(participant, std::chrono::milliseconds(static_cast<int>(o.wait_s * 1000)));
+  for (const auto& [name, info] : topics) {
+    std::printf("%-32s %-44s %zu pub, %zu sub\n", name.c_str(),
+                runtime::to_ros_type_name(info.type_name).c_str(), info.publishers.size(),
+                info.subscribers.size());
+    if (!verbose) continue;
+    std::printf("    DDS type: %s\n", info.type_name.c_str());
+    for (const auto& p : info.publishers) std::printf("    publisher:  %s\n", p.qos.c_str());
+    for (const auto& s : info.subscribers) std::printf("    subscriber: %s\n", s.qos.c_str());
+  }
+  if (topics.empty()) std::fprintf(stderr, "no topics found on domain %d\n", o.domain);
+}
+
+void run_echo(const CommonOptions& o, const introspection::YamlOptions& yaml) {
+  runtime::dds::Participant participant(o.domain);
+  RawReader reader(participant, o.topic, o.wait_s);
+  const auto& types = introspection::built_in_types();
+  const auto start = Clock::now();
+  long printed = 0;
+  while (!should_stop(o, start) && (o.count == 0 || printed < o.count)) {
+    reader.take(std::chrono::milliseconds(100), [&](std::span<const std::uint8_t> bytes,
+                                                    const dds_sample_info_t&) {
+      if (o.count != 0 && printed >= o.count) return;
+      const auto value = introspection::decode_cdr(types, reader.type().dds_name, bytes);
+      std::fputs(introspection::to_yaml(value, yaml).c_str(), stdout);
+      std::fputs("---\n", stdout);
+      std::fflush(stdout);
+      ++printed;
+    });
+  }
+}
+
+/// Rate and bandwidth over a sliding window of receive times.
+void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
+  runtime::dds::Participant participant(o.domain);
+  RawReader reader(participant, o.topic, o.wait_s);
+  std::deque<std::pair<Clock::time_point, std::size_t>> samples;
+  std::uint64_t total = 0;
+  const auto start = Clock::now();
+  auto next_print = start + std::chrono::seconds(1);
+  auto report = [&] {
+    if (samples.size() < 2) {
+      std::printf("no new messages\n");
+      return;
+    }
+    std::vector<double> dt;
+    std::size_t bytes = 0;
+    for (std::size_t i = 1; i < samples.size(); ++i) {
+      dt.push_back(std::chrono::duration<double>(samples[i].first - samples[i - 1].first).count());
+      bytes += samples[i].second;
+    }
+    double mean = 0;
+    for (double d : dt) mean += d;
+    mean /= static_cast<double>(dt.size());
+    double var = 0;
+    for (double d : dt) var += (d - mean) * (d - mean);
+    const double stddev = std::sqrt(var / static_cast<double>(dt.size()));
+    const auto [min_it, max_it] = std::minmax_element(dt.begin(), dt.end());
+    const double span_s = std::chrono::duration<double>(samples.back().first - samples.front().first).count();
+    if (bandwidth) {
+      const double bps = static_cast<double>(bytes) / span_s;
+      std::printf("%.2f MB/s from %zu messages, mean size %.0f B (min %zu B max %zu B)\n", bps / 1e6,
+                  samples.size(), static_cast<double>(bytes) / static_cast<double>(dt.size()),
+                  std::min_element(samples.begin(), samples.end(), [](auto& a, auto& b) { return a.second < b.second; })->second,
+                  std::max_element(samples.begin(), samples.end(), [](auto& a, auto& b) { return a.second < b.second; })->second);
+    } else {
+      std::printf("average rate: %.3f Hz\n\tmin: %.6fs max: %.6fs std dev: %.6fs window: %zu\n",
+                  1.0 / mean, *min_it, *max_it, stddev, samples.size());
+    }
+    std::fflush(stdout);
+  };
+  while (!should_stop(o, start)) {
+    reader.take(std::chrono::milliseconds(50), [&](std::span<const std::uint8_t> bytes,
+                                                   const dds_sample_info_t&) {
+      samples.emplace_back(Clock::now(), bytes.size());
+      ++total;
+      if (samples.size() > window) samples.pop_front();
+    });
+    if (Clock::now() >= next_print) {
+      report();
+      next_print += std::chrono::seconds(1);
+    }
+  }
+  if (total == 0) throw runtime::Error("no message received on " + reader.dds_name());
+}
+
+}  // namespace
+
+void add_topic_command(CLI::App& app) {
+  auto* topic = app.add_subcommand("topic", "Inspect topics of running graphs (any process, any host)");
+  topic->require_subcommand(1);
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+
+  static CommonOptions list_o;
+  static bool verbose = false;
+  list_o.wait_s = 1.5;
+  auto* list = topic->add_subcommand("list", "Topics seen through DDS discovery, with types and endpoint counts");
+  add_common(list, list_o, false);
+  list->add_flag("-v,--verbose", verbose, "show DDS type names and each endpoint's QoS");
+  list->callback([] { run_list(list_o, verbose); });
+
+  static CommonOptions echo_o;
+  static introspection::YamlOptions yaml;
+  auto* echo = topic->add_subcommand("echo", "Print samples as YAML (images and clouds summarised)");
+  add_common(echo, echo_o, true);
+  echo->add_option("-n,--count", echo_o.count, "print this many samples, then exit");
+  echo->add_option("--max-elements", yaml.max_list_elements, "longest list printed in full (0: all)");
+  echo->callback([] { run_echo(echo_o, yaml); });
+
+  static CommonOptions hz_o;
+  static std::size_t hz_window = 1000;
+  auto* hz = topic->add_subcommand("hz", "Receive rate: mean, min/max/std of intervals");
+  add_common(hz, hz_o, true);
+  hz->add_option("-w,--window", hz_window, "intervals in the sliding window")->capture_default_str();
+  hz->callback([] { run_rate(hz_o, false, hz_window); });
+
+  static CommonOptions bw_o;
+  static std::size_t bw_window = 1000;
+  auto* bw = topic->add_subcommand("bw", "Bandwidth: bytes per second of serialised samples");
+  add_common(bw, bw_o, true);
+  bw->add_option("-w,--window", bw_window, "messages in the sliding window")->capture_default_str();
+  bw->callback([] { run_rate(bw_o, true, bw_window); });
+}
+
+}  // namespace avs::cli
