@@ -1,11 +1,13 @@
 #include "avs/runtime/container.hpp"
 
+#include <chrono>
 #include <iostream>
 #include <map>
 #include <mutex>
 
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/topic_name.hpp"
+#include "diagnostic_msgs.h"
 #include "rosgraph_msgs.h"
 
 namespace avs::runtime {
@@ -47,6 +49,7 @@ struct Container::Impl {
   TopicEntry& topic(const std::string& dds_name, const msg::TypeEntry& type, const QosProfile& qos);
   void reader_loop();
   void fail(const std::string& what);
+  void publish_diagnostics(dds::Writer& writer);
 
   const graph::Graph& graph;
   const graph::ContainerSpec& spec;
@@ -125,13 +128,36 @@ class ComponentHost final : public ComponentContext {
   std::function<void()> guard(std::function<void()> fn) {
     return [this, fn = std::move(fn)] {
       if (!active_) return;
+      const auto start = std::chrono::steady_clock::now();
       try {
         fn();
+        record_callback(std::chrono::steady_clock::now() - start);
       } catch (const std::exception& e) {
         container_.fail("component '" + instance_.name + "' (" + instance_.type +
                         "): callback failed: " + e.what());
       }
     };
+  }
+
+ public:
+  /// Callback statistics since the last diagnostics report (wall-clock processing time).
+  struct Stats {
+    std::uint64_t callbacks = 0;
+    double total_ms = 0;
+    double max_ms = 0;
+  };
+  Stats take_stats() {
+    std::lock_guard lock(stats_mutex_);
+    return std::exchange(stats_, Stats{});
+  }
+
+ private:
+  void record_callback(std::chrono::steady_clock::duration d) {
+    const double ms = std::chrono::duration<double, std::milli>(d).count();
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.callbacks;
+    stats_.total_ms += ms;
+    stats_.max_ms = std::max(stats_.max_ms, ms);
   }
 
   /// Port -> (DDS topic name, QoS), after remaps and the graph's namespace.
@@ -163,6 +189,8 @@ class ComponentHost final : public ComponentContext {
   std::atomic<bool> active_{false};
   std::mutex timers_mutex_;
   std::vector<TimerId> timers_;
+  std::mutex stats_mutex_;
+  Stats stats_;
 };
 
 namespace {
@@ -232,6 +260,32 @@ void Container::Impl::fail(const std::string& what) {
   log.error(what);
   failed = true;
   scheduler->stop();
+}
+
+void Container::Impl::publish_diagnostics(dds::Writer& writer) {
+  if (writer.matched_readers() == 0) return;
+  auto array = make_sample<msgs::diagnostic_msgs::DiagnosticArray>();
+  to_ros_time(scheduler->now(), array->header.stamp);
+  resize_sequence(array->status, static_cast<std::uint32_t>(hosts.size()));
+  for (std::size_t i = 0; i < hosts.size(); ++i) {
+    ComponentHost& host = *hosts[i];
+    const auto stats = host.take_stats();
+    auto& status = array->status._buffer[i];
+    status.level = failed ? 2 : 0;  // DiagnosticStatus ERROR / OK
+    set_string(status.name, spec.name + "/" + host.instance().name);
+    set_string(status.message, failed ? "container failed" : "active");
+    set_string(status.hardware_id, host.instance().type);
+    const std::pair<const char*, std::string> values[] = {
+        {"callbacks", std::to_string(stats.callbacks)},
+        {"callback_ms_mean", std::to_string(stats.callbacks ? stats.total_ms / static_cast<double>(stats.callbacks) : 0.0)},
+        {"callback_ms_max", std::to_string(stats.max_ms)}};
+    resize_sequence(status.values, 3);
+    for (std::size_t k = 0; k < 3; ++k) {
+      set_string(status.values._buffer[k].key, values[k].first);
+      set_string(status.values._buffer[k].value, values[k].second);
+    }
+  }
+  writer.write(array.get());
 }
 
 void Container::Impl::reader_loop() {
@@ -322,6 +376,14 @@ int Container::run() {
     TopicEntry& topic = c.topic("rt/clock", *clock_type, clock_qos);
     if (!topic.reader) topic.reader = std::make_unique<dds::Reader>(c.participant, *topic.topic, clock_qos);
     c.clock_follow = &topic;
+  }
+
+  // Health: one DiagnosticStatus per component on /diagnostics, every second of the clock.
+  {
+    const msg::TypeEntry* diag_type = msg::find_type("diagnostic_msgs::msg::dds_::DiagnosticArray_");
+    TopicEntry& topic = c.topic("rt/diagnostics", *diag_type, QosProfile{});
+    if (!topic.writer) topic.writer = std::make_unique<dds::Writer>(c.participant, *topic.topic, QosProfile{});
+    scheduler.add_timer(0, std::chrono::seconds(1), [&c, &topic] { c.publish_diagnostics(*topic.writer); });
   }
 
   // DDS inputs from other processes.
