@@ -11,13 +11,19 @@
 #include "avs/runtime/qos.hpp"
 #include "avs/runtime/time.hpp"
 
+namespace avs::runtime {
+struct PortSpec;  // avs/runtime/component.hpp
+}  // namespace avs::runtime
+
 namespace avs::graph {
 
 struct SourceLocation {
   std::string file;
   int line = 0;    ///< 1-based
   int column = 0;  ///< 1-based
-  std::string str() const { return file + ":" + std::to_string(line) + ":" + std::to_string(column); }
+  std::string str() const {
+    return file + ":" + std::to_string(line) + ":" + std::to_string(column);
+  }
 };
 
 /// One validation error: "file:line:column: error: <message>".
@@ -28,11 +34,11 @@ struct Diagnostic {
 };
 
 struct ComponentInstance {
-  std::string type;  ///< registered component type
-  std::string name;  ///< unique in the graph
-  runtime::ParameterValues parameters;  ///< every declared parameter, defaults filled in
-  std::map<std::string, std::string> remaps;            ///< port -> ROS topic name (as written)
-  std::map<std::string, runtime::QosProfile> qos;       ///< port -> QoS override
+  std::string type;                                ///< registered component type
+  std::string name;                                ///< unique in the graph
+  runtime::ParameterValues parameters;             ///< every declared parameter, defaults filled in
+  std::map<std::string, std::string> remaps;       ///< port -> ROS topic name (as written)
+  std::map<std::string, runtime::QosProfile> qos;  ///< port -> QoS override
   SourceLocation where;
 };
 
@@ -61,7 +67,7 @@ struct ClockSpec {
   enum class Source { wall, sim } source = Source::wall;
   enum class Mode { lockstep, realtime } mode = Mode::lockstep;
   double real_time_factor = 1.0;
-  std::string master;  ///< container name; default: the first container
+  std::string master;                ///< container name; default: the first container
   std::optional<double> duration_s;  ///< stop the graph after this much (sim or wall) time
 };
 
@@ -71,7 +77,8 @@ struct Graph {
   int domain_id = 0;
   ClockSpec clock;
   std::vector<ContainerSpec> containers;
-  std::map<std::string, std::string> args;  ///< final argument values
+  std::map<std::string, std::string> args;  ///< final argument values (of the top-level file)
+  std::vector<std::string> files;           ///< every file loaded, top-level first
 
   const ContainerSpec* find_container(const std::string& name) const {
     for (const auto& c : containers) {
@@ -90,6 +97,18 @@ struct LoadResult {
 
 /// Loads and validates `file` with argument overrides ("speed" -> "0.5" from `speed:=0.5`),
 /// against the component types in runtime::ComponentRegistry.
+/// All errors of the whole file set are collected (format and error classes: docs/graphs.md).
 LoadResult load_graph(const std::string& file, const std::map<std::string, std::string>& args);
+
+/// Pulls `name:=value` words (launch argument overrides) out of `words`; the other words
+/// go to `rest` in order (when `rest` is not null). A later override of a name wins.
+std::map<std::string, std::string> parse_arg_overrides(const std::vector<std::string>& words,
+                                                       std::vector<std::string>* rest);
+
+/// The fully qualified ROS topic name of `port` of `component`: its remap (or the port's
+/// default topic) resolved against the graph's namespace, e.g. "/chat". Throws
+/// runtime::Error on an invalid name (load_graph has already reported those).
+std::string port_topic(const Graph& graph, const ComponentInstance& component,
+                       const runtime::PortSpec& port);
 
 }  // namespace avs::graph

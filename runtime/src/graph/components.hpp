@@ -1,0 +1,16 @@
+// Internal to the graph loader: reading one component entry.
+#pragma once
+
+#include <optional>
+
+#include "load_state.hpp"
+
+namespace avs::graph::detail {
+
+/// Reads and checks one entry of a container's `components:` list against the
+/// registered spec of its type; adds its topic endpoints to `state`. nullopt on errors
+/// (all reported).
+std::optional<ComponentInstance> read_component(LoadState& state, const FileReader& reader,
+                                                const YAML::Node& node);
+
+}  // namespace avs::graph::detail

@@ -1,0 +1,145 @@
+// Reading containers (processes) and the graph-wide topic type check.
+#include "avs/runtime/component.hpp"
+#include "avs/runtime/topic_name.hpp"
+#include "components.hpp"
+
+namespace avs::graph {
+namespace detail {
+namespace {
+
+const std::vector<std::string> container_keys = {"name", "host", "executor", "respawn",
+                                                 "components"};
+const std::vector<std::string> respawn_kinds = {"never", "on_failure", "always"};
+
+std::optional<RespawnPolicy> read_respawn(const FileReader& reader, const YAML::Node& node,
+                                          const std::string& what) {
+  RespawnPolicy policy;
+  if (!node.IsMap()) {
+    auto kind = reader.choice(node, what, respawn_kinds);
+    if (!kind) return std::nullopt;
+    policy.kind = static_cast<RespawnPolicy::Kind>(*kind);
+    return policy;
+  }
+  bool ok = true;
+  for (const auto& e : map_entries(reader, node, what, {"policy", "max_restarts", "backoff_s"})) {
+    const std::string field = what + " '" + e.key + "'";
+    if (e.key == "policy") {
+      auto kind = reader.choice(e.value, field, respawn_kinds);
+      if (kind) policy.kind = static_cast<RespawnPolicy::Kind>(*kind);
+      ok = ok && kind.has_value();
+    } else if (e.key == "max_restarts") {
+      auto n = reader.integer(e.value, field, 0, 1000000);
+      if (n) policy.max_restarts = static_cast<int>(*n);
+      ok = ok && n.has_value();
+    } else if (e.key == "backoff_s") {
+      auto s = reader.number(e.value, field, 0.0, 3600.0);
+      if (s) policy.backoff_s = *s;
+      ok = ok && s.has_value();
+    }
+  }
+  if (!ok) return std::nullopt;
+  return policy;
+}
+
+void read_container(LoadState& state, const FileReader& reader, const YAML::Node& node) {
+  const auto entries = map_entries(reader, node, "container", container_keys);
+  if (!node.IsMap()) return;
+  ContainerSpec container;
+  container.where = reader.at(node);
+  std::string what = "container";
+  const Entry* name_entry = find_entry(entries, "name");
+  if (name_entry == nullptr) {
+    reader.error(node, "container: missing required key 'name'");
+    state.unnamed_container = true;
+  } else if (auto name = reader.string(name_entry->value, "container 'name'")) {
+    container.name = *name;
+    container.where = reader.at(name_entry->value);
+    what = "container '" + *name + "'";
+    if (!is_identifier(*name)) {
+      reader.error(name_entry->value,
+                   "container 'name': expected letters, digits and '_' (not "
+                   "starting with a digit), got '" +
+                       *name + "'");
+      state.unnamed_container = true;
+    } else if (auto [it, inserted] = state.container_names.emplace(*name, container.where);
+               !inserted) {
+      reader.error(name_entry->value, "container 'name': duplicate container name '" + *name +
+                                          "' (first defined at " + it->second.str() + ")");
+    }
+  } else {
+    state.unnamed_container = true;
+  }
+  for (const auto& e : entries) {
+    const std::string field = what + " '" + e.key + "'";
+    if (e.key == "host") {
+      if (auto host = reader.string(e.value, field)) container.host = *host;
+    } else if (e.key == "executor") {
+      if (auto i = reader.choice(e.value, field, {"single_threaded", "thread_per_component"})) {
+        container.executor =
+            *i == 0 ? ExecutorKind::single_threaded : ExecutorKind::thread_per_component;
+      }
+    } else if (e.key == "respawn") {
+      if (auto policy = read_respawn(reader, e.value, field)) container.respawn = *policy;
+    } else if (e.key == "components") {
+      if (!e.value.IsSequence() || e.value.size() == 0) {
+        reader.error(e.value, field + ": expected a non-empty list of components, got " +
+                                  node_kind(e.value));
+        continue;
+      }
+      for (const auto& item : e.value) {
+        if (auto c = read_component(state, reader, item))
+          container.components.push_back(std::move(*c));
+      }
+    }
+  }
+  if (find_entry(entries, "components") == nullptr) {
+    reader.error(node, what + ": missing required key 'components'");
+  }
+  state.graph.containers.push_back(std::move(container));
+}
+
+std::string describe(const Endpoint& ep) {
+  return "component '" + ep.component + "' port '" + ep.port + "' " +
+         (ep.publisher ? "publishes " : "subscribes to ") + "'" + ep.topic + "' as " +
+         runtime::to_ros_type_name(ep.dds_type);
+}
+
+}  // namespace
+
+void read_containers(LoadState& state, const FileReader& reader, const YAML::Node& node) {
+  if (!node.IsSequence()) {
+    reader.error(node, "'containers': expected a list of containers, got " + node_kind(node));
+    return;
+  }
+  for (const auto& item : node) read_container(state, reader, item);
+}
+
+void check_topic_types(LoadState& state) {
+  // The reference type of a topic is its first publisher's (or, with no publisher in the
+  // graph, its first subscriber's); every endpoint that differs is one error.
+  std::map<std::string, const Endpoint*> reference;
+  for (const auto& ep : state.endpoints) {
+    if (ep.publisher) reference.emplace(ep.topic, &ep);
+  }
+  for (const auto& ep : state.endpoints) reference.emplace(ep.topic, &ep);
+  for (const auto& ep : state.endpoints) {
+    const Endpoint* ref = reference.at(ep.topic);
+    if (ref == &ep || ref->dds_type == ep.dds_type) continue;
+    std::string message = ep.publisher && ref->publisher ? "two publishers of one topic with "
+                                                           "different types: "
+                                                         : "topic type mismatch: ";
+    message += describe(ep) + ", but " + describe(*ref) + " (at " + ref->where.str() + ")";
+    state.diags.error(ep.where, message);
+  }
+}
+
+}  // namespace detail
+
+std::string port_topic(const Graph& graph, const ComponentInstance& component,
+                       const runtime::PortSpec& port) {
+  auto it = component.remaps.find(port.name);
+  return runtime::resolve_topic_name(
+      graph.ns, it != component.remaps.end() ? it->second : port.default_topic);
+}
+
+}  // namespace avs::graph

@@ -1,0 +1,220 @@
+// Typed parameter specs: factories, printing, and the range/choice check used by the
+// graph loader before anything starts.
+#include "avs/runtime/parameters.hpp"
+
+#include <charconv>
+#include <cmath>
+
+namespace avs::runtime {
+namespace {
+
+/// Shortest text that reads back as the same double ("0.1", "10000", "1e-06").
+std::string format_number(double v) {
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  if (ec != std::errc()) return std::to_string(v);
+  return std::string(buf, end);
+}
+
+/// " in [0.1, 10000] Hz", " >= 0 m", "" (no bounds, no unit).
+std::string range_text(const ParamSpec& spec) {
+  std::string r;
+  if (spec.min && spec.max) {
+    r = " in [" + format_number(*spec.min) + ", " + format_number(*spec.max) + "]";
+  } else if (spec.min) {
+    r = " >= " + format_number(*spec.min);
+  } else if (spec.max) {
+    r = " <= " + format_number(*spec.max);
+  }
+  if (!spec.unit.empty()) r += " " + spec.unit;
+  return r;
+}
+
+bool in_range(const ParamSpec& spec, double v) {
+  if (!std::isfinite(v)) return false;
+  if (spec.min && v < *spec.min) return false;
+  if (spec.max && v > *spec.max) return false;
+  return true;
+}
+
+/// How a value is shown after "got": strings quoted so that '' and ' x' are visible.
+std::string got_text(const ParamValue& value) {
+  if (std::holds_alternative<std::string>(value)) {
+    return "'" + std::get<std::string>(value) + "'";
+  }
+  return to_string(value);
+}
+
+std::string join_quoted(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& s : items) {
+    if (!out.empty()) out += ", ";
+    out += "'" + s + "'";
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string to_string(ParamType type) {
+  switch (type) {
+    case ParamType::boolean:
+      return "bool";
+    case ParamType::integer:
+      return "integer";
+    case ParamType::real:
+      return "number";
+    case ParamType::string:
+      return "string";
+    case ParamType::real_list:
+      return "list of numbers";
+  }
+  return "unknown";
+}
+
+std::string to_string(const ParamValue& value) {
+  struct Printer {
+    std::string operator()(bool b) const { return b ? "true" : "false"; }
+    std::string operator()(std::int64_t i) const { return std::to_string(i); }
+    std::string operator()(double d) const { return format_number(d); }
+    std::string operator()(const std::string& s) const { return s; }
+    std::string operator()(const std::vector<double>& list) const {
+      std::string out = "[";
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        if (i != 0) out += ", ";
+        out += format_number(list[i]);
+      }
+      return out + "]";
+    }
+  };
+  return std::visit(Printer{}, value);
+}
+
+ParamType type_of(const ParamValue& value) {
+  switch (value.index()) {
+    case 0:
+      return ParamType::boolean;
+    case 1:
+      return ParamType::integer;
+    case 2:
+      return ParamType::real;
+    case 3:
+      return ParamType::string;
+    default:
+      return ParamType::real_list;
+  }
+}
+
+ParamSpec ParamSpec::boolean(std::string name, bool def, std::string description) {
+  ParamSpec s;
+  s.name = std::move(name);
+  s.type = ParamType::boolean;
+  s.default_value = def;
+  s.description = std::move(description);
+  return s;
+}
+
+ParamSpec ParamSpec::integer(std::string name, std::int64_t def, std::optional<double> min,
+                             std::optional<double> max, std::string unit, std::string description) {
+  ParamSpec s;
+  s.name = std::move(name);
+  s.type = ParamType::integer;
+  s.default_value = def;
+  s.min = min;
+  s.max = max;
+  s.unit = std::move(unit);
+  s.description = std::move(description);
+  return s;
+}
+
+ParamSpec ParamSpec::real(std::string name, double def, std::optional<double> min,
+                          std::optional<double> max, std::string unit, std::string description) {
+  ParamSpec s;
+  s.name = std::move(name);
+  s.type = ParamType::real;
+  s.default_value = def;
+  s.min = min;
+  s.max = max;
+  s.unit = std::move(unit);
+  s.description = std::move(description);
+  return s;
+}
+
+ParamSpec ParamSpec::string(std::string name, std::string def, std::string description,
+                            std::vector<std::string> choices) {
+  ParamSpec s;
+  s.name = std::move(name);
+  s.type = ParamType::string;
+  s.default_value = std::move(def);
+  s.choices = std::move(choices);
+  s.description = std::move(description);
+  return s;
+}
+
+ParamSpec ParamSpec::real_list(std::string name, std::vector<double> def, std::string unit,
+                               std::string description) {
+  ParamSpec s;
+  s.name = std::move(name);
+  s.type = ParamType::real_list;
+  s.default_value = std::move(def);
+  s.unit = std::move(unit);
+  s.description = std::move(description);
+  return s;
+}
+
+std::string ParamSpec::check(const ParamValue& value) const {
+  const ParamType got = type_of(value);
+  switch (type) {
+    case ParamType::boolean:
+      if (got != ParamType::boolean) return "expected true or false, got " + got_text(value);
+      return {};
+    case ParamType::integer: {
+      const std::string expected = "expected an integer" + range_text(*this);
+      if (got != ParamType::integer) return expected + ", got " + got_text(value);
+      if (!in_range(*this, static_cast<double>(std::get<std::int64_t>(value)))) {
+        return expected + ", got " + got_text(value);
+      }
+      return {};
+    }
+    case ParamType::real: {
+      const std::string expected = "expected a number" + range_text(*this);
+      double v = 0.0;
+      if (got == ParamType::real) {
+        v = std::get<double>(value);
+      } else if (got == ParamType::integer) {  // integers are accepted for numbers
+        v = static_cast<double>(std::get<std::int64_t>(value));
+      } else {
+        return expected + ", got " + got_text(value);
+      }
+      if (!in_range(*this, v)) return expected + ", got " + got_text(value);
+      return {};
+    }
+    case ParamType::string: {
+      if (got != ParamType::string) {
+        if (!choices.empty()) {
+          return "expected one of " + join_quoted(choices) + ", got " + got_text(value);
+        }
+        return "expected a string, got " + got_text(value);
+      }
+      if (choices.empty()) return {};
+      for (const auto& c : choices) {
+        if (c == std::get<std::string>(value)) return {};
+      }
+      return "expected one of " + join_quoted(choices) + ", got " + got_text(value);
+    }
+    case ParamType::real_list: {
+      const std::string expected = "expected a list of numbers" + range_text(*this);
+      if (got != ParamType::real_list) return expected + ", got " + got_text(value);
+      const auto& list = std::get<std::vector<double>>(value);
+      for (std::size_t i = 0; i < list.size(); ++i) {
+        if (!in_range(*this, list[i])) {
+          return expected + ", got " + format_number(list[i]) + " at index " + std::to_string(i);
+        }
+      }
+      return {};
+    }
+  }
+  return "unknown parameter type";
+}
+
+}  // namespace avs::runtime
