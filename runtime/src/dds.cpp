@@ -1,6 +1,19 @@
 #include "avs/runtime/dds.hpp"
 
+#include <cstdlib>
+
 namespace avs::runtime::dds {
+
+int effective_domain(int configured) {
+  const char* env = std::getenv("AVS_DOMAIN_ID");
+  if (env == nullptr || *env == '\0') return configured;
+  char* end = nullptr;
+  const long id = std::strtol(env, &end, 10);
+  if (*end != '\0' || id < 0 || id > 232) {
+    throw Error(std::string("AVS_DOMAIN_ID must be a domain id in [0, 232], got '") + env + "'");
+  }
+  return static_cast<int>(id);
+}
 
 Participant::Participant(dds_domainid_t domain)
     : Entity(check_dds(dds_create_participant(domain, nullptr, nullptr),

@@ -176,7 +176,7 @@ class RawReader {
 
 struct CommonOptions {
   std::string topic;
-  int domain = 0;
+  int domain = runtime::dds::effective_domain(0);
   double wait_s = 5.0;
   double duration_s = 0;  // 0 = until Ctrl-C
   long count = 0;         // 0 = unlimited
@@ -184,7 +184,7 @@ struct CommonOptions {
 
 void add_common(CLI::App* cmd, CommonOptions& o, bool needs_topic) {
   if (needs_topic) cmd->add_option("topic", o.topic, "topic: /name, name or rt/name")->required();
-  cmd->add_option("--domain", o.domain, "DDS domain id")->capture_default_str();
+  cmd->add_option("--domain", o.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")->capture_default_str();
   cmd->add_option("--wait", o.wait_s, "seconds to wait for a publisher")->capture_default_str();
   cmd->add_option("--duration", o.duration_s, "stop after this many seconds (0: until Ctrl-C)");
 }
@@ -257,7 +257,7 @@ void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
     const double span_s = std::chrono::duration<double>(samples.back().first - samples.front().first).count();
     if (bandwidth) {
       const double bps = static_cast<double>(bytes) / span_s;
-      std::printf("%.2f MB/s from %zu messages, mean size %.0f B (min %zu B max %zu B)\n", bps / 1e6,
+      std::printf("%.3f MB/s from %zu messages, mean size %.0f B (min %zu B max %zu B)\n", bps / 1e6,
                   samples.size(), static_cast<double>(bytes) / static_cast<double>(dt.size()),
                   std::min_element(samples.begin(), samples.end(), [](auto& a, auto& b) { return a.second < b.second; })->second,
                   std::max_element(samples.begin(), samples.end(), [](auto& a, auto& b) { return a.second < b.second; })->second);

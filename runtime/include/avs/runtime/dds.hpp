@@ -13,6 +13,10 @@
 
 namespace avs::runtime::dds {
 
+/// The DDS domain to use: $AVS_DOMAIN_ID when set (tests and side-by-side systems use it
+/// to stay apart), else `configured`.
+int effective_domain(int configured);
+
 /// Owns one DDS entity handle; deletes it (and its children) on destruction.
 class Entity {
  public:
