@@ -1,0 +1,74 @@
+// Triangulation (section 4.2, Eq. 4) with look-up tables built once at start-up, and the
+// plain per-pixel 3x3 solve of Eq. 4 as a reference.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "avs/decode/sensor_geometry.hpp"
+
+namespace avs::decode {
+
+/// The paper's look-up table in a form that fits in cache (~2 MiB for 512 x 512): per camera
+/// pixel the undistorted ray (x, y, 1); per code the plane through the projector centre and the
+/// code's centre row (projector distortion included: the plane is fitted to the undistorted
+/// rays of that row's pixels). Depth along the camera z axis is then z = 1 / (a x + b y + c).
+class DepthTable {
+ public:
+  explicit DepthTable(const SensorGeometry& geometry);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int pixel_count() const { return width_ * height_; }
+  /// Index of the all-NaN plane used for invalid pixels (= 2^bit_count).
+  int invalid_index() const { return invalid_index_; }
+
+  const float* ray_x() const { return ray_x_.data(); }
+  const float* ray_y() const { return ray_y_.data(); }
+  /// 4 floats (a, b, c, 0) per binary code 0 .. 2^n, 16-byte aligned; codes >= code_count and
+  /// the last entry are NaN so that their depth is NaN.
+  const float* planes() const { return planes_.data(); }
+
+  /// Depth of `pixel_index` (row-major) for binary `code`, same arithmetic as the fast kernel.
+  float depth(int pixel_index, int code) const {
+    const float* pl = planes_.data() + 4 * code;
+    return 1.0f / (pl[0] * ray_x_[pixel_index] + pl[1] * ray_y_[pixel_index] + pl[2]);
+  }
+
+  /// Largest distance (m) between a fitted plane and the rays of its row, over all codes: 0
+  /// without projector distortion; reported so that callers can see the plane approximation.
+  double max_plane_fit_error() const { return max_plane_fit_error_; }
+
+ private:
+  int width_ = 0;
+  int height_ = 0;
+  int invalid_index_ = 0;
+  std::vector<float> ray_x_;
+  std::vector<float> ray_y_;
+  std::vector<float> planes_;
+  double max_plane_fit_error_ = 0;
+};
+
+/// Eq. 4 solved per pixel: F r_c = R with the undistorted camera pixel (x_c, y_c) and the
+/// projector row y_p at the code's centre. Projector distortion is ignored (Eq. 4 is a pinhole
+/// model), so this is exact only for a distortion-free projector.
+class ReferenceTriangulator {
+ public:
+  explicit ReferenceTriangulator(const SensorGeometry& geometry);
+
+  /// Point in the camera frame (m), NaN components when F is singular or code is invalid.
+  Eigen::Vector3d point(int pixel_index, int code) const;
+  float depth(int pixel_index, int code) const {
+    return static_cast<float>(point(pixel_index, code).z());
+  }
+
+ private:
+  Eigen::Matrix<double, 3, 4> C_;
+  Eigen::Matrix<double, 3, 4> P_;
+  int code_count_ = 0;
+  std::vector<double> row_of_code_;
+  std::vector<Eigen::Vector2d> undistorted_pixel_;  ///< (x_c, y_c) per pixel, distortion removed
+};
+
+}  // namespace avs::decode

@@ -1,0 +1,36 @@
+// The hot loop of the rolling decoder: one pair in, Gray words updated, depth out.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace avs::decode::detail {
+
+struct PairUpdateArgs {
+  const std::uint8_t* positive = nullptr;
+  std::ptrdiff_t positive_stride = 0;
+  const std::uint8_t* negative = nullptr;
+  std::ptrdiff_t negative_stride = 0;
+  int width = 0;
+  int height = 0;
+  std::uint16_t* gray = nullptr;   ///< width * height, updated in place
+  std::uint16_t* valid = nullptr;  ///< width * height, updated in place
+  int bit_position = 0;            ///< n - 1 - k
+  int threshold_psi = 0;
+  bool code_correction = false;
+  std::uint16_t full_mask = 0;  ///< (1 << n) - 1
+  /// Depth output; null to update the bits only.
+  float* depth_m = nullptr;
+  const float* ray_x = nullptr;
+  const float* ray_y = nullptr;
+  const float* planes = nullptr;  ///< (a, b, c, 0) per binary code, NaN for invalid codes
+  int invalid_index = 0;
+  float min_depth_m = 0;
+  float max_depth_m = 0;
+};
+
+/// Eq. 2 binarisation of one pair, bit k written into every pixel's Gray word (with Algorithm 1
+/// when enabled), Gray -> binary, and depth = 1 / (a x + b y + c) from the tables.
+void update_pair(const PairUpdateArgs& args);
+
+}  // namespace avs::decode::detail

@@ -1,0 +1,119 @@
+#include "avs/decode/triangulation.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Dense>
+
+namespace avs::decode {
+namespace {
+
+void check_geometry(const SensorGeometry& g) {
+  const CodeLayout& l = g.layout;
+  if (g.camera.width <= 0 || g.camera.height <= 0 || g.camera.fx_px <= 0 || g.camera.fy_px <= 0 ||
+      g.projector.fx_px <= 0 || g.projector.fy_px <= 0) {
+    throw std::invalid_argument("sensor geometry: camera/projector intrinsics not set (camera " +
+                                std::to_string(g.camera.width) + "x" +
+                                std::to_string(g.camera.height) + ")");
+  }
+  if (l.bit_count < 1 || l.bit_count > 15 || l.code_count < 1 ||
+      l.code_count > (1 << l.bit_count) || l.rows_per_code < 1) {
+    throw std::invalid_argument("sensor geometry: invalid code layout (" +
+                                std::to_string(l.bit_count) + " bits, " +
+                                std::to_string(l.code_count) + " codes, " +
+                                std::to_string(l.rows_per_code) + " rows per code)");
+  }
+}
+
+}  // namespace
+
+DepthTable::DepthTable(const SensorGeometry& g) {
+  check_geometry(g);
+  width_ = g.camera.width;
+  height_ = g.camera.height;
+  invalid_index_ = 1 << g.layout.bit_count;
+
+  // Per-pixel undistorted camera rays (x, y, 1).
+  ray_x_.resize(static_cast<std::size_t>(pixel_count()));
+  ray_y_.resize(ray_x_.size());
+  for (int v = 0; v < height_; ++v) {
+    for (int u = 0; u < width_; ++u) {
+      const Eigen::Vector3d r = g.camera.ray(u, v);
+      ray_x_[static_cast<std::size_t>(v) * width_ + u] = static_cast<float>(r.x());
+      ray_y_[static_cast<std::size_t>(v) * width_ + u] = static_cast<float>(r.y());
+    }
+  }
+
+  // Per-code planes through the projector centre and the code's centre row. With projector
+  // distortion the row's rays are not exactly coplanar: fit the plane (smallest eigenvector of
+  // the rays' scatter matrix, the plane passing through the centre by construction).
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  planes_.assign(4 * static_cast<std::size_t>(invalid_index_ + 1), nan);
+  const Eigen::Vector3d centre = g.projector_centre_camera_m();
+  const Eigen::Matrix3d R_camera_projector = g.R_projector_camera.transpose();
+  const int column_step = g.projector.has_distortion() ? 1 : std::max(1, g.projector.width - 1);
+  for (int code = 0; code < g.layout.code_count; ++code) {
+    const double row = g.code_centre_row(code);
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    std::vector<Eigen::Vector3d> rays;
+    for (int u = 0; u < g.projector.width; u += column_step) {
+      const Eigen::Vector3d d = (R_camera_projector * g.projector.ray(u, row)).normalized();
+      scatter += d * d.transpose();
+      rays.push_back(d);
+    }
+    if (rays.size() < 2) {
+      rays.push_back(
+          (R_camera_projector * g.projector.ray(g.projector.width - 1, row)).normalized());
+      scatter += rays.back() * rays.back().transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+    const Eigen::Vector3d normal = solver.eigenvectors().col(0);
+    for (const auto& d : rays)
+      max_plane_fit_error_ = std::max(max_plane_fit_error_, std::abs(normal.dot(d)));
+    // Plane n . X = n . centre; a camera ray X = z (x, y, 1) meets it at z = 1 / (n' . (x, y, 1))
+    // with n' = n / (n . centre).
+    const double offset = normal.dot(centre);
+    if (std::abs(offset) < 1e-12) continue;  // plane through the camera centre: no depth
+    const Eigen::Vector3d abc = normal / offset;
+    for (int i = 0; i < 3; ++i)
+      planes_[4 * static_cast<std::size_t>(code) + i] = static_cast<float>(abc[i]);
+    planes_[4 * static_cast<std::size_t>(code) + 3] = 0.0f;
+  }
+}
+
+ReferenceTriangulator::ReferenceTriangulator(const SensorGeometry& g)
+    : C_(g.camera_matrix()), P_(g.projector_matrix()), code_count_(g.layout.code_count) {
+  check_geometry(g);
+  row_of_code_.resize(static_cast<std::size_t>(code_count_));
+  for (int code = 0; code < code_count_; ++code) row_of_code_[code] = g.code_centre_row(code);
+  undistorted_pixel_.resize(static_cast<std::size_t>(g.camera.width) * g.camera.height);
+  for (int v = 0; v < g.camera.height; ++v) {
+    for (int u = 0; u < g.camera.width; ++u) {
+      const Eigen::Vector3d r = g.camera.ray(u, v);
+      undistorted_pixel_[static_cast<std::size_t>(v) * g.camera.width + u] = {
+          g.camera.fx_px * r.x() + g.camera.cx_px, g.camera.fy_px * r.y() + g.camera.cy_px};
+    }
+  }
+}
+
+Eigen::Vector3d ReferenceTriangulator::point(int pixel_index, int code) const {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (code < 0 || code >= code_count_) return {nan, nan, nan};
+  const double xc = undistorted_pixel_[pixel_index].x();
+  const double yc = undistorted_pixel_[pixel_index].y();
+  const double yp = row_of_code_[code];
+  // Eq. 4.
+  Eigen::Matrix3d F;
+  F << C_(0, 0) - C_(2, 0) * xc, C_(0, 1) - C_(2, 1) * xc, C_(0, 2) - C_(2, 2) * xc,
+      C_(1, 0) - C_(2, 0) * yc, C_(1, 1) - C_(2, 1) * yc, C_(1, 2) - C_(2, 2) * yc,
+      P_(1, 0) - P_(2, 0) * yp, P_(1, 1) - P_(2, 1) * yp, P_(1, 2) - P_(2, 2) * yp;
+  const Eigen::Vector3d R(C_(2, 3) * xc - C_(0, 3), C_(2, 3) * yc - C_(1, 3),
+                          P_(2, 3) * yp - P_(1, 3));
+  const auto lu = F.partialPivLu();
+  if (!(std::abs(lu.determinant()) > 1e-12)) return {nan, nan, nan};
+  return lu.solve(R);
+}
+
+}  // namespace avs::decode
