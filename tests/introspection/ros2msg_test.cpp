@@ -21,6 +21,16 @@ TEST(RosTypeName, DemanglesLikeRmwCyclonedds) {
   EXPECT_EQ(ros_type_name("a::msg::dds_::NoUnderscore"), "a::msg::dds_::NoUnderscore");
 }
 
+TEST(RosTypeName, MangleIsTheInverse) {
+  for (const auto& [name, type] : built_in_types().types()) {
+    EXPECT_EQ(dds_type_name(ros_type_name(name)), name);
+  }
+  EXPECT_EQ(dds_type_name("std_msgs/msg/Header"), "std_msgs::msg::dds_::Header_");
+  EXPECT_EQ(dds_type_name("std_msgs/Header"), "");
+  EXPECT_EQ(dds_type_name("a/b/c/d"), "");
+  EXPECT_EQ(dds_type_name("/msg/X"), "");
+}
+
 TEST(Ros2Msg, Header) {
   EXPECT_EQ(ros2msg_definition(built_in_types(), "std_msgs::msg::dds_::Header_"),
             kHeaderMsg + kDelimiter + "MSG: builtin_interfaces/Time\n" + kTimeMsg);

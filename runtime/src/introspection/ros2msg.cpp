@@ -91,6 +91,18 @@ std::string ros_type_name(std::string_view dds_name) {
   return out + std::string(name.substr(0, name.size() - 1));
 }
 
+std::string dds_type_name(std::string_view ros_name) {
+  const auto first = ros_name.find('/');
+  const auto last = ros_name.rfind('/');
+  if (first == std::string_view::npos || first == 0 || last == first ||
+      last + 1 == ros_name.size() || ros_name.find('/', first + 1) != last) {
+    return "";
+  }
+  return std::string(ros_name.substr(0, first)) +
+         "::" + std::string(ros_name.substr(first + 1, last - first - 1)) +
+         "::dds_::" + std::string(ros_name.substr(last + 1)) + "_";
+}
+
 namespace {
 
 // "sensor_msgs/msg/Image" -> {"sensor_msgs", "Image"}; the `.msg` reference form drops "/msg/".

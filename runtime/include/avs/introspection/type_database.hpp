@@ -115,6 +115,10 @@ const TypeDatabase& built_in_types();
 /// the trailing '_' are returned unchanged.
 std::string ros_type_name(std::string_view dds_name);
 
+/// The inverse, as rmw_cyclonedds mangles ROS names: "sensor_msgs/msg/Image" ->
+/// "sensor_msgs::msg::dds_::Image_". Returns "" for a name that is not "pkg/ns/Type".
+std::string dds_type_name(std::string_view ros_type_name);
+
 /// The complete `ros2msg` definition as rosbag2 stores it in MCAP Schema records: the root
 /// type's `.msg` text (constants first, then fields), then each dependency depth-first, each
 /// once, in alphabetical order per definition, as "\n" + 80 '=' + "\nMSG: pkg/Type\n" + text.
