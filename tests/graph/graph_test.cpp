@@ -186,6 +186,11 @@ TEST_F(GraphTest, SubscriberTypeDiffersFromPublisher) {
                     "component 'camera' port 'image' publishes '/robot/image' as "
                     "sensor_msgs/msg/Image"});
 }
+TEST_F(GraphTest, IncompatibleQosAcrossContainers) {
+  expect_one_error("qos_incompatible.yaml", 8, 15,
+                   {"incompatible QoS", "component 'viewer' port 'image'", "container 'display'",
+                    "component 'camera'", "a reliable reader needs a reliable writer"});
+}
 TEST_F(GraphTest, MissingIncludeFile) {
   expect_one_error("missing_include.yaml", 2, 11,
                    {"include 'file'", "'sub/does_not_exist.yaml' not found"});
@@ -350,6 +355,9 @@ TEST_F(GraphTest, IncludesWithArgs) {
   const auto& right = component(g, "right_camera");
   EXPECT_DOUBLE_EQ(right.parameters.get<double>("exposure_us"), 100.0);  // included file's default
   EXPECT_EQ(port_topic(g, right, port_of("fake_camera", "image")), "/right/image");
+  const auto& viewer_qos = component(g, "viewer").qos.at("image");
+  EXPECT_EQ(viewer_qos.reliability, runtime::Reliability::best_effort);
+  EXPECT_EQ(viewer_qos.depth, port_of("fake_viewer", "image").qos.depth);  // the rest kept
 }
 
 TEST_F(GraphTest, EnvironmentAndListArguments) {

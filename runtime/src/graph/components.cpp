@@ -216,7 +216,8 @@ std::string known_types_hint(std::string_view type) {
 }  // namespace
 
 std::optional<ComponentInstance> read_component(LoadState& state, const FileReader& reader,
-                                                const YAML::Node& node) {
+                                                const YAML::Node& node,
+                                                const std::string& container) {
   const auto entries = map_entries(reader, node, "component", component_keys);
   if (!node.IsMap()) return std::nullopt;
   ComponentInstance instance;
@@ -315,6 +316,7 @@ std::optional<ComponentInstance> read_component(LoadState& state, const FileRead
   }
 
   // 4. QoS overrides: a named profile or single policies.
+  std::map<std::string, SourceLocation> qos_where;
   if (const Entry* qos = find_entry(entries, "qos")) {
     for (const auto& e : map_entries(reader, qos->value, what + " 'qos'", {})) {
       const runtime::PortSpec* port = find_port(reader, spec, e, what + " 'qos'");
@@ -324,26 +326,35 @@ std::optional<ComponentInstance> read_component(LoadState& state, const FileRead
       }
       if (auto profile = read_qos(reader, *port, e.value, what + " qos '" + e.key + "'")) {
         instance.qos[e.key] = *profile;
+        qos_where[e.key] = reader.at(e.value);
       } else {
         ok = false;
       }
     }
   }
 
-  // 5. Endpoints for the graph-wide type check.
+  // 5. Endpoints for the graph-wide type and QoS checks.
   auto add_endpoints = [&](const std::vector<runtime::PortSpec>& ports, bool publisher) {
     for (const auto& port : ports) {
       auto remapped = instance.remaps.find(port.name);
       const std::string& topic =
           remapped != instance.remaps.end() ? remapped->second : port.default_topic;
       try {
-        Endpoint ep{runtime::resolve_topic_name(state.graph.ns, topic),
-                    port.dds_type,
-                    publisher,
-                    instance.name,
-                    port.name,
-                    instance.where};
+        Endpoint ep;
+        ep.topic = runtime::resolve_topic_name(state.graph.ns, topic);
+        ep.dds_type = port.dds_type;
+        ep.publisher = publisher;
+        ep.component = instance.name;
+        ep.port = port.name;
+        ep.container = container;
+        ep.where = instance.where;
         if (auto w = remap_where.find(port.name); w != remap_where.end()) ep.where = w->second;
+        ep.qos = port.qos;
+        ep.qos_where = ep.where;
+        if (auto q = instance.qos.find(port.name); q != instance.qos.end()) {
+          ep.qos = q->second;
+          ep.qos_where = qos_where.at(port.name);
+        }
         state.endpoints.push_back(std::move(ep));
       } catch (const runtime::Error& err) {
         reader.error(type_entry->value,

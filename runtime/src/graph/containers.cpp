@@ -87,7 +87,7 @@ void read_container(LoadState& state, const FileReader& reader, const YAML::Node
         continue;
       }
       for (const auto& item : e.value) {
-        if (auto c = read_component(state, reader, item))
+        if (auto c = read_component(state, reader, item, container.name))
           container.components.push_back(std::move(*c));
       }
     }
@@ -96,6 +96,22 @@ void read_container(LoadState& state, const FileReader& reader, const YAML::Node
     reader.error(node, what + ": missing required key 'components'");
   }
   state.graph.containers.push_back(std::move(container));
+}
+
+/// Why a writer offering `pub` cannot serve a reader requesting `sub`, or "".
+std::string qos_incompatibility(const runtime::QosProfile& pub, const runtime::QosProfile& sub) {
+  if (sub.reliability == runtime::Reliability::reliable &&
+      pub.reliability == runtime::Reliability::best_effort) {
+    return "a reliable reader needs a reliable writer";
+  }
+  if (sub.durability == runtime::Durability::transient_local &&
+      pub.durability == runtime::Durability::volatile_) {
+    return "a transient_local reader needs a transient_local writer";
+  }
+  if (sub.deadline && (!pub.deadline || *pub.deadline > *sub.deadline)) {
+    return "the reader's deadline is shorter than the writer's";
+  }
+  return "";
 }
 
 std::string describe(const Endpoint& ep) {
@@ -114,9 +130,9 @@ void read_containers(LoadState& state, const FileReader& reader, const YAML::Nod
   for (const auto& item : node) read_container(state, reader, item);
 }
 
-void check_topic_types(LoadState& state) {
-  // The reference type of a topic is its first publisher's (or, with no publisher in the
-  // graph, its first subscriber's); every endpoint that differs is one error.
+void check_topics(LoadState& state) {
+  // 1. Types. The reference type of a topic is its first publisher's (or, with no
+  // publisher in the graph, its first subscriber's); every endpoint that differs is one error.
   std::map<std::string, const Endpoint*> reference;
   for (const auto& ep : state.endpoints) {
     if (ep.publisher) reference.emplace(ep.topic, &ep);
@@ -125,11 +141,32 @@ void check_topic_types(LoadState& state) {
   for (const auto& ep : state.endpoints) {
     const Endpoint* ref = reference.at(ep.topic);
     if (ref == &ep || ref->dds_type == ep.dds_type) continue;
-    std::string message = ep.publisher && ref->publisher ? "two publishers of one topic with "
-                                                           "different types: "
-                                                         : "topic type mismatch: ";
+    std::string message = ep.publisher && ref->publisher
+                              ? "two publishers of one topic with different types: "
+                              : "topic type mismatch: ";
     message += describe(ep) + ", but " + describe(*ref) + " (at " + ref->where.str() + ")";
     state.diags.error(ep.where, message);
+  }
+  // 2. QoS across processes (DDS request/offer rules). Inside one container samples are
+  // handed over directly, so only publishers in other containers matter.
+  for (const auto& sub : state.endpoints) {
+    if (sub.publisher) continue;
+    for (const auto& pub : state.endpoints) {
+      if (!pub.publisher || pub.topic != sub.topic || pub.dds_type != sub.dds_type ||
+          pub.container == sub.container) {
+        continue;
+      }
+      const std::string problem = qos_incompatibility(pub.qos, sub.qos);
+      if (problem.empty()) continue;
+      state.diags.error(sub.qos_where,
+                        "incompatible QoS: component '" + sub.component + "' port '" + sub.port +
+                            "' (container '" + sub.container + "') subscribes to '" + sub.topic +
+                            "' with " + sub.qos.describe() + ", but component '" + pub.component +
+                            "' (container '" + pub.container + "', at " + pub.where.str() +
+                            ") publishes with " + pub.qos.describe() + ": " + problem +
+                            "; DDS will not deliver between them (set 'qos' on either port)");
+      break;  // one error per subscriber
+    }
   }
 }
 

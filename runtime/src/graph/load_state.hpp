@@ -16,7 +16,10 @@ struct Endpoint {
   bool publisher = false;
   std::string component;
   std::string port;
-  SourceLocation where;  ///< the remap value, or the component's name
+  std::string container;
+  SourceLocation where;      ///< the remap value, or the component's name
+  runtime::QosProfile qos;   ///< the port's declared QoS or its override
+  SourceLocation qos_where;  ///< the QoS override, or `where`
 };
 
 struct LoadState {
@@ -33,7 +36,8 @@ struct LoadState {
 /// Reads the `containers:` list of one file into state.graph.containers.
 void read_containers(LoadState& state, const FileReader& reader, const YAML::Node& node);
 
-/// Reports endpoints of one topic whose types differ.
-void check_topic_types(LoadState& state);
+/// Reports endpoints of one topic whose types differ, and subscribers in one container
+/// whose QoS no publisher in another container can satisfy (DDS would never match them).
+void check_topics(LoadState& state);
 
 }  // namespace avs::graph::detail

@@ -275,7 +275,7 @@ void check_graph(LoadState& state) {
                           did_you_mean(graph.clock.master, names) +
                           "; containers: " + join_quoted(names));
   }
-  check_topic_types(state);
+  check_topics(state);
 }
 
 }  // namespace
