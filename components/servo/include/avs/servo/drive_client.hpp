@@ -1,0 +1,177 @@
+// The host side of the servo amplifiers: a libmodbus client (TCP or RTU) that runs the cyclic
+// exchange for one or more axes, drives each axis's CiA 402 state machine, and applies the
+// safety rules (safety.hpp) to every torque it writes. No threads of its own: cycle() is
+// called by the owner's cyclic thread (or a simulation in lockstep) with the current time;
+// set_command()/set_estop() may be called from other threads.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "avs/servo/cia402.hpp"
+#include "avs/servo/link_budget.hpp"
+#include "avs/servo/modbus_handle.hpp"
+#include "avs/servo/register_map.hpp"
+#include "avs/servo/safety.hpp"
+#include "avs/servo/statistics.hpp"
+
+namespace avs::servo {
+
+enum class Transport : std::uint8_t { tcp, rtu };
+
+struct TcpLinkConfig {
+  std::string host = "127.0.0.1";
+  int port = 502;
+};
+
+struct RtuLinkConfig {
+  std::string device = "/dev/ttyUSB0";
+  SerialLine line;                     ///< baud, parity, data and stop bits
+  bool rs485 = true;                   ///< modbus_rtu_set_serial_mode(MODBUS_RTU_RS485)
+  int rts = MODBUS_RTU_RTS_NONE;       ///< MODBUS_RTU_RTS_NONE / _UP / _DOWN (direction pin)
+  int rts_delay_us = -1;               ///< -1: libmodbus default
+  double drive_turnaround_s = 0.0005;  ///< drive's reply delay, used by the link budget
+};
+
+enum class EstopAction : std::uint8_t {
+  disable_operation,  ///< torque 0 and controlword 0x07: torque off at once (default)
+  quick_stop,         ///< torque 0 and controlword 0x02: the drive brakes per 0x605A
+};
+
+struct DriveAxisConfig {
+  std::string name = "pan";
+  int unit_id = 1;
+  RegisterMap registers;  ///< must be complete (see default_register_map)
+  AxisSafetyConfig safety;
+  std::int16_t mode_of_operation = mode_cyclic_synchronous_torque;
+};
+
+struct DriveClientConfig {
+  Transport transport = Transport::tcp;
+  TcpLinkConfig tcp;
+  RtuLinkConfig rtu;
+  std::vector<DriveAxisConfig> axes;
+  double cycle_rate_hz = 1000.0;
+  double response_timeout_s = 0.0005;  ///< must be below the period
+  double command_timeout_s = 0.02;     ///< older commands -> zero torque
+  bool use_write_read_0x17 = true;     ///< else 0x10 write(s) + 0x03 read
+  double reconnect_backoff_initial_s = 0.005;
+  double reconnect_backoff_max_s = 0.5;
+  EstopAction estop_action = EstopAction::disable_operation;
+  bool auto_fault_reset = false;  ///< reset drive faults without request_fault_reset()
+};
+
+/// Default two-axis configuration for the simulated amplifier (pan unit 1, tilt unit 2).
+DriveClientConfig default_drive_client_config(const std::string& host, int port);
+
+struct AxisFeedback {
+  bool valid = false;  ///< from this cycle's successful exchange
+  double q_rad = 0;
+  double qd_rad_s = 0;
+  double torque_actual_nm = 0;
+  std::uint16_t statusword = 0;
+  DriveState state = DriveState::not_ready_to_switch_on;
+  std::uint16_t error_code = 0;
+  double commanded_torque_nm = 0;  ///< what this cycle wrote (0 when not written)
+  std::uint32_t safety_reasons = safety_none;
+};
+
+struct CycleResult {
+  bool link_ok = false;       ///< every axis exchanged and checked
+  bool link_fault = false;    ///< a fault happened or the link is down / backing off
+  std::string fault_message;  ///< the first fault of this cycle, with axis and cause
+  std::vector<AxisFeedback> axes;
+};
+
+struct LinkStatistics {
+  std::uint64_t exchanges = 0;  ///< successful, checked axis exchanges
+  std::uint64_t timeouts = 0;
+  std::uint64_t exceptions = 0;     ///< Modbus exception replies
+  std::uint64_t stale_replies = 0;  ///< echo counter mismatch
+  std::uint64_t errors = 0;         ///< other I/O errors (reset, broken pipe, bad data)
+  std::uint64_t reconnects = 0;     ///< successful re-connections after a fault
+  std::uint64_t connect_failures = 0;
+  double rtt_us_p50 = 0;  ///< per axis exchange, over the recent window
+  double rtt_us_p99 = 0;
+};
+
+class DriveClient {
+ public:
+  /// Validates the configuration (register maps, timeouts, RTU link budget); throws
+  /// ConfigError with one explanatory line when it is refused.
+  explicit DriveClient(DriveClientConfig config);
+  ~DriveClient();
+  DriveClient(const DriveClient&) = delete;
+  DriveClient& operator=(const DriveClient&) = delete;
+
+  /// Configure: connects, checks the word order probe, writes mode and drive torque limits.
+  /// Throws ModbusError/ConfigError naming the axis on failure.
+  void connect();
+  /// Closes the link after writing controlword 0 (disable voltage) to every axis, best effort.
+  void disconnect();
+
+  /// Enable on activate: from the next cycles, 0x06 -> 0x07 -> 0x0F gated on the statusword,
+  /// with torque 0 until enabled; commands stamped before `now_s` are discarded.
+  void activate(double now_s);
+  /// Disable on deactivate: torque 0 and 0x07 (Switched on).
+  void deactivate();
+  void request_fault_reset();
+  /// E-stop: from the next cycle torque 0 (and the estop action). Releasing it discards
+  /// commands stamped before `now_s`.
+  void set_estop(bool active, double now_s);
+  /// Latest torque command (motor N m, one per axis) stamped with the sender's time.
+  void set_command(const std::vector<double>& torque_nm, double stamp_s);
+
+  /// One cyclic exchange with every axis at time now_s (same time base as the stamps).
+  CycleResult cycle(double now_s);
+
+  LinkStatistics statistics() const;
+  const DriveClientConfig& config() const { return config_; }
+  bool connected() const { return ctx_ != nullptr; }
+
+ private:
+  struct WriteRun {
+    std::uint16_t address = 0;
+    std::uint16_t count = 0;
+  };
+  struct AxisRuntime {
+    std::vector<WriteRun> write_runs;
+    std::uint16_t read_address = 0;
+    std::uint16_t read_count = 0;
+    std::uint16_t counter = 0;
+    AxisFeedback last;    ///< last good feedback
+    int reset_phase = 0;  ///< fault reset edge: 0 write bit 7 low, 1 write bit 7 high
+  };
+  enum class ExchangeError : std::uint8_t { none, timeout, exception, stale, io };
+
+  void open_link();       ///< throws
+  void configure_axes();  ///< throws
+  void close_link();
+  std::uint16_t next_controlword(std::size_t axis, bool want_enabled, bool estop, bool reset);
+  ExchangeError exchange(std::size_t axis, std::uint16_t controlword, double torque_nm,
+                         AxisFeedback& feedback, std::string& message);
+  void on_link_fault(double now_s, ExchangeError error, const std::string& message);
+
+  DriveClientConfig config_;
+  std::vector<AxisRuntime> axes_;
+  ModbusContext ctx_;
+  double next_connect_s_ = -std::numeric_limits<double>::infinity();
+  double backoff_s_ = 0;
+  bool had_fault_ = false;
+  std::string fatal_error_;  ///< configuration mismatch found on reconnect: no more retries
+
+  mutable std::mutex command_mutex_;  ///< guards the fields below and stats_
+  std::vector<double> command_nm_;
+  double command_stamp_s_ = std::numeric_limits<double>::quiet_NaN();
+  double accept_after_s_ = -std::numeric_limits<double>::infinity();
+  bool want_enabled_ = false;
+  bool estop_ = false;
+  bool fault_reset_requested_ = false;
+  LinkStatistics stats_;
+  SampleWindow rtt_us_;
+};
+
+}  // namespace avs::servo
