@@ -1,0 +1,776 @@
+#include "decoder.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <queue>
+#include <set>
+
+#include "checksum.hpp"
+#include "compression.hpp"
+#include "serialize.hpp"
+
+namespace avs::mcap::detail {
+
+namespace {
+
+constexpr std::uint64_t kFooterRecordSize = kRecordPrefixSize + 8 + 8 + 4;
+
+std::string at(std::uint64_t offset) {
+  return "offset " + std::to_string(offset);
+}
+
+std::string record_where(const RecordView& r) {
+  return std::string(opcode_name(r.opcode)) + " record at " + at(r.offset);
+}
+
+}  // namespace
+
+const char* opcode_name(std::uint8_t opcode) {
+  switch (static_cast<Opcode>(opcode)) {
+    case Opcode::header:
+      return "Header";
+    case Opcode::footer:
+      return "Footer";
+    case Opcode::schema:
+      return "Schema";
+    case Opcode::channel:
+      return "Channel";
+    case Opcode::message:
+      return "Message";
+    case Opcode::chunk:
+      return "Chunk";
+    case Opcode::message_index:
+      return "Message Index";
+    case Opcode::chunk_index:
+      return "Chunk Index";
+    case Opcode::attachment:
+      return "Attachment";
+    case Opcode::attachment_index:
+      return "Attachment Index";
+    case Opcode::statistics:
+      return "Statistics";
+    case Opcode::metadata:
+      return "Metadata";
+    case Opcode::metadata_index:
+      return "Metadata Index";
+    case Opcode::summary_offset:
+      return "Summary Offset";
+    case Opcode::data_end:
+      return "Data End";
+  }
+  return opcode == 0 ? "invalid opcode 0x00" : "unknown-opcode";
+}
+
+Status parse_schema(std::span<const std::byte> content, std::uint64_t base,
+                    const std::string& where, Schema& out) {
+  Cursor c(content, base, where);
+  out.id = c.u16();
+  out.name = c.string("schema name");
+  out.encoding = c.string("schema encoding");
+  auto data = c.bytes32("schema data");
+  out.data.assign(reinterpret_cast<const char*>(data.data()), data.size());
+  return c.status();
+}
+
+Status parse_channel(std::span<const std::byte> content, std::uint64_t base,
+                     const std::string& where, Channel& out) {
+  Cursor c(content, base, where);
+  out.id = c.u16();
+  out.schema_id = c.u16();
+  out.topic = c.string("channel topic");
+  out.message_encoding = c.string("channel message_encoding");
+  out.metadata = c.string_map("channel metadata");
+  return c.status();
+}
+
+Status parse_message(std::span<const std::byte> content, std::uint64_t base,
+                     const std::string& where, MessageFields& out) {
+  Cursor c(content, base, where);
+  out.channel_id = c.u16();
+  out.sequence = c.u32();
+  out.log_time = c.u64();
+  out.publish_time = c.u64();
+  out.data = c.rest();
+  return c.status();
+}
+
+Decoder::Decoder(std::unique_ptr<Source> source, const ReaderOptions& options)
+    : source_(std::move(source)), options_(options) {}
+
+Status Decoder::read_record(std::uint64_t offset, std::uint64_t limit, ByteBuffer& scratch,
+                            RecordView& out) {
+  if (offset > limit || limit - offset < kRecordPrefixSize) {
+    return Status(StatusCode::truncated, "record at " + at(offset) + ": needs " +
+                                             std::to_string(kRecordPrefixSize) +
+                                             " bytes for opcode and length, only " +
+                                             std::to_string(offset > limit ? 0 : limit - offset) +
+                                             " remain before " + at(limit));
+  }
+  std::span<const std::byte> prefix;
+  if (Status s = source_->view(offset, kRecordPrefixSize, scratch, prefix); !s.ok()) return s;
+  out.offset = offset;
+  out.opcode = static_cast<std::uint8_t>(prefix[0]);
+  const std::uint64_t length = load_u64(prefix.data() + 1);
+  const std::uint64_t available = limit - offset - kRecordPrefixSize;
+  if (length > available) {
+    return Status(StatusCode::truncated, std::string(opcode_name(out.opcode)) + " record at " +
+                                             at(offset) + " declares " + std::to_string(length) +
+                                             " content bytes, only " + std::to_string(available) +
+                                             " remain before " + at(limit));
+  }
+  if (length > options_.max_record_bytes) {
+    return Status(StatusCode::too_large, std::string(opcode_name(out.opcode)) + " record at " +
+                                             at(offset) + " has " + std::to_string(length) +
+                                             " content bytes, above the reader limit " +
+                                             std::to_string(options_.max_record_bytes));
+  }
+  return source_->view(offset + kRecordPrefixSize, length, scratch, out.content);
+}
+
+Status Decoder::open() {
+  const std::uint64_t size = source_->size();
+  if (size < kMagicSize) {
+    return Status(StatusCode::truncated, "file of " + std::to_string(size) +
+                                             " bytes is too short for the MCAP magic at " + at(0));
+  }
+  ByteBuffer scratch;
+  std::span<const std::byte> magic;
+  if (Status s = source_->view(0, kMagicSize, scratch, magic); !s.ok()) return s;
+  if (std::memcmp(magic.data(), kMagic, kMagicSize) != 0) {
+    return Status(StatusCode::malformed, "not an MCAP file: bad magic at " + at(0));
+  }
+  RecordView header;
+  if (Status s = read_record(kMagicSize, size, scratch, header); !s.ok()) return s;
+  if (header.opcode != static_cast<std::uint8_t>(Opcode::header)) {
+    return Status(StatusCode::malformed, "first record at " + at(kMagicSize) + " is " +
+                                             opcode_name(header.opcode) + ", not Header");
+  }
+  Cursor c(header.content, kMagicSize + kRecordPrefixSize, "Header record at " + at(kMagicSize));
+  header_.profile = c.string("profile");
+  header_.library = c.string("library");
+  header_end_ = kMagicSize + header.total_length();
+  return c.status();
+}
+
+Status Decoder::add_schema(Schema schema, std::uint64_t offset) {
+  if (schema.id == 0) return {};  // spec: ignored by readers
+  auto [it, inserted] = schemas_.emplace(schema.id, schema);
+  if (!inserted && (it->second.name != schema.name || it->second.encoding != schema.encoding ||
+                    it->second.data != schema.data)) {
+    return Status(StatusCode::malformed, "Schema record at " + at(offset) +
+                                             " redefines schema id " + std::to_string(schema.id) +
+                                             " differently");
+  }
+  return {};
+}
+
+Status Decoder::add_channel(Channel channel, std::uint64_t offset) {
+  auto [it, inserted] = channels_.emplace(channel.id, channel);
+  if (!inserted &&
+      (it->second.topic != channel.topic ||
+       it->second.message_encoding != channel.message_encoding ||
+       it->second.schema_id != channel.schema_id || it->second.metadata != channel.metadata)) {
+    return Status(StatusCode::malformed, "Channel record at " + at(offset) +
+                                             " redefines channel id " + std::to_string(channel.id) +
+                                             " differently");
+  }
+  return {};
+}
+
+Status Decoder::load_chunk(const RecordView& record, ByteBuffer& decompressed, ChunkView& out) {
+  const std::string where = "Chunk record at " + at(record.offset);
+  Cursor c(record.content, record.offset + kRecordPrefixSize, where);
+  out.offset = record.offset;
+  out.message_start_time = c.u64();
+  out.message_end_time = c.u64();
+  out.uncompressed_size = c.u64();
+  out.uncompressed_crc = c.u32();
+  out.compression = c.string("compression");
+  auto stored = c.bytes64("records");
+  if (!c.ok()) return c.status();
+  out.compressed_size = stored.size();
+  if (out.uncompressed_size > options_.max_chunk_uncompressed_bytes) {
+    return Status(StatusCode::too_large, where + ": uncompressed_size " +
+                                             std::to_string(out.uncompressed_size) +
+                                             " is above the reader limit " +
+                                             std::to_string(options_.max_chunk_uncompressed_bytes));
+  }
+  if (out.compression.empty()) {
+    if (stored.size() != out.uncompressed_size) {
+      return Status(StatusCode::malformed,
+                    where + ": uncompressed chunk holds " + std::to_string(stored.size()) +
+                        " bytes, uncompressed_size says " + std::to_string(out.uncompressed_size));
+    }
+    out.records = stored;
+  } else {
+    if (Status s =
+            decompress(out.compression, stored, out.uncompressed_size, record.offset, decompressed);
+        !s.ok()) {
+      return s;
+    }
+    out.records = decompressed.span();
+  }
+  if (options_.verify_chunk_crc && out.uncompressed_crc != 0) {
+    std::uint32_t computed = crc32_update(0, out.records);
+    if (computed != out.uncompressed_crc) {
+      return Status(StatusCode::crc_mismatch, where + ": CRC of the uncompressed records is " +
+                                                  hex(computed) + ", the chunk says " +
+                                                  hex(out.uncompressed_crc));
+    }
+  }
+  return {};
+}
+
+Status Decoder::walk_chunk(
+    const ChunkView& chunk,
+    const std::function<Status(std::uint64_t, const MessageFields&)>& on_message) {
+  const std::string chunk_where = "Chunk record at " + at(chunk.offset);
+  std::uint64_t pos = 0;
+  const std::uint64_t size = chunk.records.size();
+  while (pos < size) {
+    const std::string where =
+        chunk_where + ", inner record at uncompressed offset " + std::to_string(pos);
+    if (size - pos < kRecordPrefixSize) {
+      return Status(StatusCode::malformed, where + ": needs 9 bytes for opcode and length, only " +
+                                               std::to_string(size - pos) + " remain");
+    }
+    const auto opcode = static_cast<std::uint8_t>(chunk.records[pos]);
+    const std::uint64_t length = load_u64(chunk.records.data() + pos + 1);
+    if (length > size - pos - kRecordPrefixSize) {
+      return Status(StatusCode::malformed, where + " (" + opcode_name(opcode) + ") declares " +
+                                               std::to_string(length) + " bytes, only " +
+                                               std::to_string(size - pos - kRecordPrefixSize) +
+                                               " remain in the chunk");
+    }
+    auto content = chunk.records.subspan(pos + kRecordPrefixSize, length);
+    const std::uint64_t base = pos + kRecordPrefixSize;
+    switch (static_cast<Opcode>(opcode)) {
+      case Opcode::schema: {
+        Schema schema;
+        if (Status s = parse_schema(content, base, where, schema); !s.ok()) return s;
+        if (Status s = add_schema(std::move(schema), chunk.offset); !s.ok()) return s;
+        break;
+      }
+      case Opcode::channel: {
+        Channel channel;
+        if (Status s = parse_channel(content, base, where, channel); !s.ok()) return s;
+        if (Status s = add_channel(std::move(channel), chunk.offset); !s.ok()) return s;
+        break;
+      }
+      case Opcode::message: {
+        MessageFields fields;
+        if (Status s = parse_message(content, base, where, fields); !s.ok()) return s;
+        if (channels_.count(fields.channel_id) == 0) {
+          return Status(StatusCode::malformed, where + ": Message on unknown channel id " +
+                                                   std::to_string(fields.channel_id));
+        }
+        if (Status s = on_message(pos, fields); !s.ok()) return s;
+        break;
+      }
+      default:
+        if (opcode == 0 || opcode < 0x80) {
+          return Status(StatusCode::malformed,
+                        where + ": " + opcode_name(opcode) + " is not allowed inside a chunk");
+        }
+        break;  // private opcodes are skipped
+    }
+    pos += kRecordPrefixSize + length;
+  }
+  return {};
+}
+
+MessageView Decoder::make_view(const MessageFields& fields) const {
+  MessageView view;
+  const Channel& channel = channels_.at(fields.channel_id);  // checked by the caller
+  view.channel = &channel;
+  auto schema = schemas_.find(channel.schema_id);
+  view.schema = schema == schemas_.end() ? nullptr : &schema->second;
+  view.sequence = fields.sequence;
+  view.log_time = fields.log_time;
+  view.publish_time = fields.publish_time;
+  view.data = fields.data;
+  return view;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Summary (fast path).
+
+Status Decoder::read_summary(Footer& footer, Summary& summary, bool& has_summary) {
+  has_summary = false;
+  const std::uint64_t size = source_->size();
+  if (size < header_end_ + kFooterRecordSize + kMagicSize) {
+    return Status(StatusCode::truncated, "no room for a Footer: file of " + std::to_string(size) +
+                                             " bytes ends right after the Header (which ends at " +
+                                             at(header_end_) + ")");
+  }
+  ByteBuffer scratch;
+  std::span<const std::byte> tail;
+  const std::uint64_t footer_offset = size - kMagicSize - kFooterRecordSize;
+  if (Status s = source_->view(footer_offset, kFooterRecordSize + kMagicSize, scratch, tail);
+      !s.ok()) {
+    return s;
+  }
+  if (std::memcmp(tail.data() + kFooterRecordSize, kMagic, kMagicSize) != 0) {
+    return Status(StatusCode::truncated, "no trailing magic at " + at(size - kMagicSize) +
+                                             " (file truncated, or the writer did not close it)");
+  }
+  if (static_cast<std::uint8_t>(tail[0]) != static_cast<std::uint8_t>(Opcode::footer) ||
+      load_u64(tail.data() + 1) != 20) {
+    return Status(StatusCode::malformed,
+                  "no Footer record (opcode 0x02, length 20) at " + at(footer_offset));
+  }
+  footer.summary_start = load_u64(tail.data() + 9);
+  footer.summary_offset_start = load_u64(tail.data() + 17);
+  footer.summary_crc = load_u32(tail.data() + 25);
+  if (footer.summary_start == 0) return {};  // valid file without a summary
+  if (footer.summary_start < header_end_ || footer.summary_start > footer_offset) {
+    return Status(StatusCode::malformed, "Footer at " + at(footer_offset) + ": summary_start " +
+                                             std::to_string(footer.summary_start) +
+                                             " lies outside [" + std::to_string(header_end_) +
+                                             ", " + std::to_string(footer_offset) + "]");
+  }
+  std::uint64_t summary_end = footer_offset;
+  if (footer.summary_offset_start != 0) {
+    if (footer.summary_offset_start < footer.summary_start ||
+        footer.summary_offset_start > footer_offset) {
+      return Status(StatusCode::malformed,
+                    "Footer at " + at(footer_offset) + ": summary_offset_start " +
+                        std::to_string(footer.summary_offset_start) + " lies outside [" +
+                        std::to_string(footer.summary_start) + ", " +
+                        std::to_string(footer_offset) + "]");
+    }
+    summary_end = footer.summary_offset_start;
+  }
+  // One read covers the summary, the summary offsets and the footer up to its CRC field.
+  ByteBuffer summary_bytes;
+  std::span<const std::byte> region;
+  const std::uint64_t crc_end = footer_offset + kRecordPrefixSize + 16;
+  if (Status s = source_->view(footer.summary_start, crc_end - footer.summary_start, summary_bytes,
+                               region);
+      !s.ok()) {
+    return s;
+  }
+  if (footer.summary_crc != 0) {
+    std::uint32_t computed = crc32_update(0, region);
+    if (computed != footer.summary_crc) {
+      return Status(StatusCode::crc_mismatch,
+                    "summary section from " + at(footer.summary_start) + " to " + at(crc_end) +
+                        ": CRC is " + hex(computed) + ", the Footer at " + at(footer_offset) +
+                        " says " + hex(footer.summary_crc));
+    }
+  }
+  Summary parsed;
+  std::uint64_t pos = footer.summary_start;
+  while (pos < summary_end) {
+    const std::uint64_t rel = pos - footer.summary_start;
+    const std::uint64_t left = summary_end - pos;
+    if (left < kRecordPrefixSize) {
+      return Status(StatusCode::malformed, "summary record at " + at(pos) +
+                                               ": needs 9 bytes for opcode and length, only " +
+                                               std::to_string(left) + " remain");
+    }
+    RecordView record;
+    record.offset = pos;
+    record.opcode = static_cast<std::uint8_t>(region[rel]);
+    const std::uint64_t length = load_u64(region.data() + rel + 1);
+    if (length > left - kRecordPrefixSize) {
+      return Status(StatusCode::malformed,
+                    std::string(opcode_name(record.opcode)) + " record at " + at(pos) +
+                        " declares " + std::to_string(length) + " bytes, only " +
+                        std::to_string(left - kRecordPrefixSize) + " remain in the summary");
+    }
+    record.content = region.subspan(rel + kRecordPrefixSize, length);
+    const std::string where = record_where(record);
+    const std::uint64_t base = pos + kRecordPrefixSize;
+    Cursor c(record.content, base, where);
+    switch (static_cast<Opcode>(record.opcode)) {
+      case Opcode::schema: {
+        Schema schema;
+        if (Status s = parse_schema(record.content, base, where, schema); !s.ok()) return s;
+        if (Status s = add_schema(schema, pos); !s.ok()) return s;
+        if (schema.id != 0) parsed.schemas[schema.id] = std::move(schema);
+        break;
+      }
+      case Opcode::channel: {
+        Channel channel;
+        if (Status s = parse_channel(record.content, base, where, channel); !s.ok()) return s;
+        if (Status s = add_channel(channel, pos); !s.ok()) return s;
+        parsed.channels[channel.id] = std::move(channel);
+        break;
+      }
+      case Opcode::chunk_index: {
+        ChunkIndex index;
+        index.message_start_time = c.u64();
+        index.message_end_time = c.u64();
+        index.chunk_start_offset = c.u64();
+        index.chunk_length = c.u64();
+        index.message_index_offsets = c.u16_u64_map("message_index_offsets");
+        index.message_index_length = c.u64();
+        index.compression = c.string("compression");
+        index.compressed_size = c.u64();
+        index.uncompressed_size = c.u64();
+        if (!c.ok()) return c.status();
+        parsed.chunk_indexes.push_back(std::move(index));
+        break;
+      }
+      case Opcode::statistics: {
+        Statistics stats;
+        stats.message_count = c.u64();
+        stats.schema_count = c.u16();
+        stats.channel_count = c.u32();
+        stats.attachment_count = c.u32();
+        stats.metadata_count = c.u32();
+        stats.chunk_count = c.u32();
+        stats.message_start_time = c.u64();
+        stats.message_end_time = c.u64();
+        stats.channel_message_counts = c.u16_u64_map("channel_message_counts");
+        if (!c.ok()) return c.status();
+        parsed.statistics = std::move(stats);
+        break;
+      }
+      case Opcode::metadata_index: {
+        MetadataIndex index;
+        index.offset = c.u64();
+        index.length = c.u64();
+        index.name = c.string("name");
+        if (!c.ok()) return c.status();
+        parsed.metadata_indexes.push_back(std::move(index));
+        break;
+      }
+      case Opcode::attachment_index:
+        break;  // attachments are not read by this library
+      default:
+        if (record.opcode == 0 || record.opcode < 0x80) {
+          return Status(StatusCode::malformed, where + " is not allowed in the summary section");
+        }
+        break;
+    }
+    pos += kRecordPrefixSize + length;
+  }
+  summary = std::move(parsed);
+  has_summary = true;
+  return {};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Linear scan.
+
+Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCallback& on_message,
+                     const RecordHook& hook) {
+  result = ScanResult{};
+  result.header = header_;
+  const std::uint64_t size = source_->size();
+  ByteBuffer scratch;
+  ByteBuffer decompressed;
+  std::span<const std::byte> head;
+  if (Status s = source_->view(0, header_end_, scratch, head); !s.ok()) return s;
+  std::uint32_t crc = crc32_update(0, head);
+  Statistics stats;
+  bool stopped_by_callback = false;
+  ChunkIndex* last_chunk = nullptr;  // the chunk whose Message Index records may follow
+  std::uint64_t pos = header_end_;
+  result.last_complete_offset = pos;
+
+  auto count_message = [&](const MessageFields& fields) {
+    if (stats.message_count == 0) {
+      stats.message_start_time = stats.message_end_time = fields.log_time;
+    } else {
+      stats.message_start_time = std::min(stats.message_start_time, fields.log_time);
+      stats.message_end_time = std::max(stats.message_end_time, fields.log_time);
+    }
+    ++stats.message_count;
+    ++stats.channel_message_counts[fields.channel_id];
+  };
+  auto deliver = [&](const MessageFields& fields) {
+    if (on_message && !stopped_by_callback && !on_message(make_view(fields))) {
+      stopped_by_callback = true;
+    }
+  };
+
+  while (true) {
+    RecordView record;
+    if (pos == size) {
+      Status missing(StatusCode::truncated,
+                     "file ends at " + at(pos) + " without a Data End record");
+      if (!allow_truncated) return missing;
+      result.truncated = true;
+      result.truncated_at = pos;
+      result.truncation_detail = missing.message();
+      break;
+    }
+    if (Status s = read_record(pos, size, scratch, record); !s.ok()) {
+      if (s.code() != StatusCode::truncated || !allow_truncated) return s;
+      result.truncated = true;
+      result.truncated_at = pos;
+      result.truncation_detail = s.message();
+      break;
+    }
+    const std::string where = record_where(record);
+    const std::uint64_t base = pos + kRecordPrefixSize;
+    const auto op = static_cast<Opcode>(record.opcode);
+    ChunkMessageIndex chunk_index;
+    bool keep_last_chunk = false;
+    if (op == Opcode::data_end) {
+      Cursor c(record.content, base, where);
+      std::uint32_t stored = c.u32();
+      if (!c.ok()) return c.status();
+      if (stored != 0) {
+        if (stored != crc) {
+          return Status(StatusCode::crc_mismatch, "data section CRC up to the Data End record at " +
+                                                      at(pos) + " is " + hex(crc) +
+                                                      ", the record says " + hex(stored));
+        }
+        result.data_crc_checked = true;
+      }
+      result.data_end_offset = pos;
+      result.last_complete_offset = pos + record.total_length();
+      break;
+    }
+    switch (op) {
+      case Opcode::schema: {
+        Schema schema;
+        if (Status s = parse_schema(record.content, base, where, schema); !s.ok()) return s;
+        if (Status s = add_schema(std::move(schema), pos); !s.ok()) return s;
+        break;
+      }
+      case Opcode::channel: {
+        Channel channel;
+        if (Status s = parse_channel(record.content, base, where, channel); !s.ok()) return s;
+        if (Status s = add_channel(std::move(channel), pos); !s.ok()) return s;
+        break;
+      }
+      case Opcode::message: {
+        MessageFields fields;
+        if (Status s = parse_message(record.content, base, where, fields); !s.ok()) return s;
+        if (channels_.count(fields.channel_id) == 0) {
+          return Status(StatusCode::malformed,
+                        where + ": unknown channel id " + std::to_string(fields.channel_id));
+        }
+        ++result.loose_message_count;
+        count_message(fields);
+        deliver(fields);
+        break;
+      }
+      case Opcode::chunk: {
+        ChunkView chunk;
+        if (Status s = load_chunk(record, decompressed, chunk); !s.ok()) return s;
+        Status walked = walk_chunk(chunk, [&](std::uint64_t offset, const MessageFields& fields) {
+          chunk_index[fields.channel_id].emplace_back(fields.log_time, offset);
+          count_message(fields);
+          deliver(fields);
+          return Status{};
+        });
+        if (!walked.ok()) return walked;
+        ChunkIndex index;
+        index.message_start_time = chunk.message_start_time;
+        index.message_end_time = chunk.message_end_time;
+        index.chunk_start_offset = pos;
+        index.chunk_length = record.total_length();
+        index.compression = chunk.compression;
+        index.compressed_size = chunk.compressed_size;
+        index.uncompressed_size = chunk.uncompressed_size;
+        result.summary.chunk_indexes.push_back(std::move(index));
+        last_chunk = &result.summary.chunk_indexes.back();
+        keep_last_chunk = true;
+        break;
+      }
+      case Opcode::message_index: {
+        Cursor c(record.content, base, where);
+        ChannelId channel = c.u16();
+        auto entries = c.bytes32("records");
+        if (!c.ok()) return c.status();
+        if (entries.size() % 16 != 0) {
+          return Status(StatusCode::malformed, where + ": records byte length " +
+                                                   std::to_string(entries.size()) +
+                                                   " is not a multiple of 16");
+        }
+        if (last_chunk != nullptr) {
+          last_chunk->message_index_offsets[channel] = pos;
+          last_chunk->message_index_length += record.total_length();
+          keep_last_chunk = true;
+        }
+        break;
+      }
+      case Opcode::metadata: {
+        Cursor c(record.content, base, where);
+        MetadataIndex index{pos, record.total_length(), c.string("name")};
+        (void)c.string_map("metadata");
+        if (!c.ok()) return c.status();
+        result.summary.metadata_indexes.push_back(std::move(index));
+        ++stats.metadata_count;
+        break;
+      }
+      case Opcode::attachment:
+        ++stats.attachment_count;
+        break;
+      default:
+        if (record.opcode == 0 || record.opcode < 0x80) {
+          return Status(StatusCode::malformed,
+                        where + " is not allowed in the data section (Data End missing?)");
+        }
+        break;  // private records are skipped
+    }
+    if (!keep_last_chunk) last_chunk = nullptr;
+    if (hook) {
+      if (Status s = hook(record, op == Opcode::chunk ? &chunk_index : nullptr); !s.ok()) {
+        return s;
+      }
+    }
+    // The data CRC covers the raw record (prefix re-encoded: identical to the file bytes).
+    unsigned char prefix[kRecordPrefixSize];
+    prefix[0] = record.opcode;
+    write_u64_at(reinterpret_cast<std::byte*>(prefix + 1), record.content.size());
+    crc = crc32_update(crc, std::as_bytes(std::span(prefix)));
+    crc = crc32_update(crc, record.content);
+    pos += record.total_length();
+    result.last_complete_offset = pos;
+    if (stopped_by_callback) break;
+  }
+  result.summary.schemas = schemas_;
+  result.summary.channels = channels_;
+  stats.schema_count = static_cast<std::uint16_t>(schemas_.size());
+  stats.channel_count = static_cast<std::uint32_t>(channels_.size());
+  stats.chunk_count = static_cast<std::uint32_t>(result.summary.chunk_indexes.size());
+  for (const auto& [id, channel] : channels_) stats.channel_message_counts.try_emplace(id, 0);
+  result.summary.statistics = std::move(stats);
+  return {};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Log-time ordered read through chunk indexes: a k-way merge over the chunks whose time range
+// may hold the next message.
+
+Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
+                             bool trust_index_channels, const ReadOptions& options,
+                             const MessageCallback& on_message, std::uint64_t& delivered) {
+  std::set<ChannelId> wanted;
+  const bool filter_topics = !options.topics.empty();
+  for (const auto& [id, channel] : channels_) {
+    if (!filter_topics || options.topics.count(channel.topic) > 0) wanted.insert(id);
+  }
+  std::vector<const ChunkIndex*> chunks;
+  for (const ChunkIndex& index : summary.chunk_indexes) {
+    if (index.message_end_time < options.start_time ||
+        index.message_start_time > options.end_time) {
+      continue;
+    }
+    if (filter_topics && trust_index_channels && !index.message_index_offsets.empty()) {
+      bool any = std::any_of(index.message_index_offsets.begin(), index.message_index_offsets.end(),
+                             [&](const auto& entry) { return wanted.count(entry.first) > 0; });
+      if (!any) continue;
+    }
+    chunks.push_back(&index);
+  }
+  std::stable_sort(chunks.begin(), chunks.end(), [](const ChunkIndex* a, const ChunkIndex* b) {
+    if (a->message_start_time != b->message_start_time) {
+      return a->message_start_time < b->message_start_time;
+    }
+    return a->chunk_start_offset < b->chunk_start_offset;
+  });
+
+  struct Entry {
+    Timestamp log_time;
+    std::uint64_t offset;
+    MessageFields fields;
+  };
+  struct Slot {
+    ByteBuffer raw;
+    ByteBuffer decompressed;
+    std::vector<Entry> entries;
+    std::size_t next = 0;
+    std::size_t order = 0;
+  };
+  std::vector<std::unique_ptr<Slot>> slots;
+  std::vector<std::size_t> free_slots;
+  struct Head {
+    Timestamp log_time;
+    std::size_t order;
+    std::size_t entry;
+    std::size_t slot;
+    bool operator>(const Head& o) const {
+      if (log_time != o.log_time) return log_time > o.log_time;
+      if (order != o.order) return order > o.order;
+      return entry > o.entry;
+    }
+  };
+  std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
+
+  auto load = [&](std::size_t order) -> Status {
+    const ChunkIndex& index = *chunks[order];
+    const std::string where = "Chunk Index for the chunk at " + at(index.chunk_start_offset);
+    if (index.chunk_start_offset < header_end_ || index.chunk_start_offset > data_limit ||
+        index.chunk_length > data_limit - index.chunk_start_offset ||
+        index.chunk_length < kRecordPrefixSize) {
+      return Status(StatusCode::malformed,
+                    where + ": chunk_length " + std::to_string(index.chunk_length) +
+                        " does not fit in the data section [" + std::to_string(header_end_) + ", " +
+                        std::to_string(data_limit) + ")");
+    }
+    std::size_t slot_id;
+    if (!free_slots.empty()) {
+      slot_id = free_slots.back();
+      free_slots.pop_back();
+    } else {
+      slot_id = slots.size();
+      slots.push_back(std::make_unique<Slot>());
+    }
+    Slot& slot = *slots[slot_id];
+    slot.entries.clear();
+    slot.next = 0;
+    slot.order = order;
+    RecordView record;
+    if (Status s = read_record(index.chunk_start_offset,
+                               index.chunk_start_offset + index.chunk_length, slot.raw, record);
+        !s.ok()) {
+      return Status(StatusCode::malformed, where + ": " + s.message());
+    }
+    if (record.opcode != static_cast<std::uint8_t>(Opcode::chunk) ||
+        record.total_length() != index.chunk_length) {
+      return Status(StatusCode::malformed, where + " does not point at a Chunk record of length " +
+                                               std::to_string(index.chunk_length) + " (found " +
+                                               opcode_name(record.opcode) + ")");
+    }
+    ChunkView chunk;
+    if (Status s = load_chunk(record, slot.decompressed, chunk); !s.ok()) return s;
+    Status walked = walk_chunk(chunk, [&](std::uint64_t offset, const MessageFields& fields) {
+      if (fields.log_time >= options.start_time && fields.log_time <= options.end_time &&
+          (!filter_topics || options.topics.count(channels_.at(fields.channel_id).topic) > 0)) {
+        slot.entries.push_back({fields.log_time, offset, fields});
+      }
+      return Status{};
+    });
+    if (!walked.ok()) return walked;
+    std::stable_sort(slot.entries.begin(), slot.entries.end(),
+                     [](const Entry& a, const Entry& b) { return a.log_time < b.log_time; });
+    if (slot.entries.empty()) {
+      free_slots.push_back(slot_id);
+    } else {
+      heads.push({slot.entries[0].log_time, order, 0, slot_id});
+    }
+    return {};
+  };
+
+  std::size_t next_chunk = 0;
+  while (true) {
+    while (next_chunk < chunks.size() &&
+           (heads.empty() || chunks[next_chunk]->message_start_time <= heads.top().log_time)) {
+      if (Status s = load(next_chunk); !s.ok()) return s;
+      ++next_chunk;
+    }
+    if (heads.empty()) break;
+    Head head = heads.top();
+    heads.pop();
+    Slot& slot = *slots[head.slot];
+    const Entry& entry = slot.entries[head.entry];
+    ++delivered;
+    if (!on_message(make_view(entry.fields))) return {};
+    if (++slot.next < slot.entries.size()) {
+      heads.push({slot.entries[slot.next].log_time, slot.order, slot.next, head.slot});
+    } else {
+      free_slots.push_back(head.slot);
+    }
+  }
+  return {};
+}
+
+}  // namespace avs::mcap::detail

@@ -1,0 +1,154 @@
+#include <cstdio>
+
+#include "avs/mcap/reader.hpp"
+#include "decoder.hpp"
+#include "serialize.hpp"
+#include "tail_writer.hpp"
+
+namespace avs::mcap {
+
+namespace {
+
+void count_message(Statistics& stats, ChannelId channel, Timestamp log_time) {
+  if (stats.message_count == 0) {
+    stats.message_start_time = stats.message_end_time = log_time;
+  } else {
+    stats.message_start_time = std::min(stats.message_start_time, log_time);
+    stats.message_end_time = std::max(stats.message_end_time, log_time);
+  }
+  ++stats.message_count;
+  ++stats.channel_message_counts[channel];
+}
+
+}  // namespace
+
+Status repair_file(const std::filesystem::path& input, const std::filesystem::path& output,
+                   RepairReport& report) {
+  report = RepairReport{};
+  std::unique_ptr<detail::Source> source;
+  if (Status s = detail::open_file_source(input, source); !s.ok()) return s;
+  detail::Decoder decoder(std::move(source), ReaderOptions{});
+  if (Status s = decoder.open(); !s.ok()) {
+    return Status(s.code(),
+                  input.string() + ": cannot repair, the start of the file is bad: " + s.message());
+  }
+  {
+    Footer footer;
+    Summary summary;
+    bool has_summary = false;
+    report.input_had_summary =
+        decoder.read_summary(footer, summary, has_summary).ok() && has_summary;
+  }
+  std::unique_ptr<detail::Source> again;
+  if (Status s = detail::open_file_source(input, again); !s.ok()) return s;
+  detail::Decoder scanner(std::move(again), ReaderOptions{});
+  if (Status s = scanner.open(); !s.ok()) return s;
+
+  const std::filesystem::path temporary = output.string() + ".repair-tmp";
+  detail::OutputFile file;
+  if (Status s = file.open(temporary); !s.ok()) return s;
+  detail::ByteBuffer buffer;
+  buffer.append(kMagic, kMagicSize);
+  std::size_t at = detail::begin_record(buffer, Opcode::header);
+  detail::put_string(buffer, scanner.header().profile);
+  detail::put_string(buffer, scanner.header().library);
+  detail::end_record(buffer, at);
+  if (Status s = file.write(buffer); !s.ok()) return s;
+
+  std::vector<ChunkIndex> chunk_indexes;
+  std::vector<MetadataIndex> metadata_indexes;
+  Statistics stats;
+  auto copy_record = [&](const detail::RecordView& record) {
+    buffer.clear();
+    detail::put_u8(buffer, record.opcode);
+    detail::put_u64(buffer, record.content.size());
+    if (Status s = file.write(buffer); !s.ok()) return s;
+    return file.write(record.content);
+  };
+  auto hook = [&](const detail::RecordView& record,
+                  const detail::ChunkMessageIndex* chunk) -> Status {
+    const auto op = static_cast<Opcode>(record.opcode);
+    if (op == Opcode::message_index) return {};  // regenerated below
+    const std::uint64_t offset = file.position();
+    if (Status s = copy_record(record); !s.ok()) return s;
+    if (op == Opcode::chunk && chunk != nullptr) {
+      ChunkIndex index;
+      detail::Cursor c(record.content, 0, "chunk");
+      index.message_start_time = c.u64();
+      index.message_end_time = c.u64();
+      index.uncompressed_size = c.u64();
+      (void)c.u32();
+      index.compression = c.string("compression");
+      index.compressed_size = c.u64();
+      index.chunk_start_offset = offset;
+      index.chunk_length = record.total_length();
+      buffer.clear();
+      detail::put_message_index_records(buffer, file.position(), *chunk,
+                                        index.message_index_offsets);
+      index.message_index_length = buffer.size();
+      if (Status s = file.write(buffer); !s.ok()) return s;
+      for (const auto& [channel, entries] : *chunk) {
+        for (const auto& entry : entries) count_message(stats, channel, entry.first);
+        report.messages_kept += entries.size();
+      }
+      chunk_indexes.push_back(std::move(index));
+      ++report.chunks_kept;
+    } else if (op == Opcode::message) {
+      detail::MessageFields fields;
+      if (Status s = detail::parse_message(record.content, 0, "message", fields); s.ok()) {
+        count_message(stats, fields.channel_id, fields.log_time);
+        ++report.messages_kept;
+      }
+    } else if (op == Opcode::metadata) {
+      detail::Cursor c(record.content, 0, "metadata");
+      metadata_indexes.push_back({offset, record.total_length(), c.string("name")});
+      ++stats.metadata_count;
+    } else if (op == Opcode::attachment) {
+      ++stats.attachment_count;
+    }
+    return {};
+  };
+
+  ScanResult scanned;
+  Status scan_status = scanner.scan(scanned, /*allow_truncated=*/true, {}, hook);
+  if (!scan_status.ok() && scan_status.code() == StatusCode::io_error) {
+    (void)file.close();
+    std::remove(temporary.c_str());
+    return scan_status;
+  }
+  if (!scan_status.ok()) {
+    report.stopped_because = scan_status.message();
+    report.input_truncated = true;
+  } else if (scanned.truncated) {
+    report.stopped_because = scanned.truncation_detail;
+    report.input_truncated = true;
+    report.input_truncated_at = scanned.truncated_at;
+  }
+  if (scanned.data_end_offset == 0 && scanner.source().size() > scanned.last_complete_offset) {
+    report.bytes_dropped = scanner.source().size() - scanned.last_complete_offset;
+  }
+
+  for (const auto& [id, channel] : scanner.channels())
+    stats.channel_message_counts.try_emplace(id, 0);
+  stats.schema_count = static_cast<std::uint16_t>(scanner.schemas().size());
+  stats.channel_count = static_cast<std::uint32_t>(scanner.channels().size());
+  stats.chunk_count = static_cast<std::uint32_t>(chunk_indexes.size());
+  detail::TailContent tail{&scanner.schemas(), &scanner.channels(), &chunk_indexes,
+                           &metadata_indexes, stats};
+  Status written = detail::write_tail(file, tail, true, true);
+  Status closed = file.close();
+  if (!written.ok() || !closed.ok()) {
+    std::remove(temporary.c_str());
+    return written.ok() ? closed : written;
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, output, error);
+  if (error) {
+    std::remove(temporary.c_str());
+    return Status(StatusCode::io_error, "rename " + temporary.string() + " -> " + output.string() +
+                                            ": " + error.message());
+  }
+  return {};
+}
+
+}  // namespace avs::mcap
