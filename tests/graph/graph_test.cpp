@@ -101,6 +101,15 @@ void expect_one_error(const std::string& name, int line, int column,
             0u);
 }
 
+const ComponentInstance& component(const Graph& g, const std::string& name) {
+  for (const auto& c : g.containers) {
+    for (const auto& i : c.components) {
+      if (i.name == name) return i;
+    }
+  }
+  throw std::runtime_error("no component " + name);
+}
+
 // ---- bad graphs: one class each ------------------------------------------------------
 
 TEST_F(GraphTest, YamlSyntaxError) {
@@ -209,7 +218,7 @@ TEST_F(GraphTest, IncludeGivesUndeclaredArg) {
 }
 TEST_F(GraphTest, UndefinedArgSubstitution) {
   expect_one_error("undefined_arg.yaml", 8, 31,
-                   {"undefined argument 'rate' in '$(arg rate)'", "'rate_hz'"});
+                   {"undefined argument 'rate' in '$(arg rate)'", "did you mean 'rate_hz'"});
 }
 TEST_F(GraphTest, UnsetEnvironmentVariable) {
   ASSERT_EQ(std::getenv("AVS_GRAPH_TEST_NEVER_SET"), nullptr);
@@ -222,6 +231,19 @@ TEST_F(GraphTest, OverrideOfUndeclaredArg) {
 }
 TEST_F(GraphTest, OverrideCheckedLikeAnyValue) {
   expect_one_error("overridable.yaml", 8, 31, {"parameter 'rate_hz'", "got 0"}, {{"rate_hz", "0"}});
+}
+TEST_F(GraphTest, RequiredArgNotGiven) {
+  expect_one_error("required_arg.yaml", 2, 3,
+                   {"argument 'rate_hz' has no default", "rate_hz:=VALUE"});
+}
+TEST_F(GraphTest, RequiredArgGiven) {
+  const LoadResult result = load_graph(data("bad/required_arg.yaml"), {{"rate_hz", "20"}});
+  ASSERT_TRUE(result.ok()) << all_errors(result);
+  EXPECT_DOUBLE_EQ(component(*result.graph, "talker").parameters.get<double>("rate_hz"), 20.0);
+}
+TEST_F(GraphTest, ScalarWhereListExpected) {
+  expect_one_error("scalar_for_list.yaml", 6, 29,
+                   {"parameter 'gains'", "expected a list of numbers, got '3'"});
 }
 TEST_F(GraphTest, DuplicateComponentName) {
   expect_one_error("duplicate_component.yaml", 7, 37,
@@ -265,15 +287,6 @@ TEST_F(GraphTest, MissingTopLevelFile) {
 }
 
 // ---- good graphs ----------------------------------------------------------------------
-
-const ComponentInstance& component(const Graph& g, const std::string& name) {
-  for (const auto& c : g.containers) {
-    for (const auto& i : c.components) {
-      if (i.name == name) return i;
-    }
-  }
-  throw std::runtime_error("no component " + name);
-}
 
 const PortSpec& port_of(const std::string& type, const std::string& port) {
   return *runtime::ComponentRegistry::instance().find(type)->spec.find_port(port);

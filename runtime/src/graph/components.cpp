@@ -50,9 +50,9 @@ std::optional<ParamValue> read_list(const FileReader& reader, const ParamSpec& s
     auto text = reader.string(node, what);
     if (!text) return std::nullopt;
     try {
-      list = YAML::Load(*text);
+      list.reset(YAML::Load(*text));  // reset: operator= would write into `node`
     } catch (const YAML::Exception&) {
-      list = YAML::Node(*text);
+      list.reset(YAML::Node(*text));
     }
     if (!list.IsSequence()) {
       reader.error(node, what + ": " + expectation(spec) + ", got '" + *text + "'");

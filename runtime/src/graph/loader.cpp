@@ -1,5 +1,6 @@
 // load_graph(): reads a graph file and its includes, substitutes arguments, and
 // validates everything before anything starts. Format: docs/graphs.md.
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -56,6 +57,7 @@ void read_args(LoadState& state, FileReader& reader, const Entry* args_entry,
         continue;
       }
       declared.push_back(e.key);
+      reader.declared_args.push_back(e.key);
       if (auto it = given.values.find(e.key); it != given.values.end()) {
         reader.args[e.key] = it->second;
         continue;
@@ -64,7 +66,7 @@ void read_args(LoadState& state, FileReader& reader, const Entry* args_entry,
       if (e.value.IsMap()) {
         auto fields = map_entries(reader, e.value, what, {"default", "description"});
         const Entry* d = find_entry(fields, "default");
-        def = d != nullptr ? d->value : YAML::Node();
+        def.reset(d != nullptr ? d->value : YAML::Node());  // reset: operator= writes through
       }
       if (!def || def.IsNull()) {
         reader.error(e.key_node, what + " has no default and was not given" +
@@ -200,7 +202,9 @@ void load_file(LoadState& state, const std::string& path, const GivenArgs& given
   state.graph.files.push_back(path);
   auto root = parse_yaml(state, path);
   if (!root) return;
-  FileReader reader{path, {}, &state.diags};
+  FileReader reader;
+  reader.file = path;
+  reader.diags = &state.diags;
   if (!root->IsMap()) {
     reader.error(*root,
                  "graph file: expected a mapping with 'containers', got " + node_kind(*root));
@@ -292,6 +296,19 @@ LoadResult load_graph(const std::string& file, const std::map<std::string, std::
   detail::check_graph(state);
   LoadResult result;
   result.errors = state.diags.take();
+  // Report in reading order: by file (as loaded), then line and column.
+  auto file_rank = [&](const std::string& f) {
+    const auto& files = state.graph.files;
+    return static_cast<std::size_t>(std::find(files.begin(), files.end(), f) - files.begin());
+  };
+  std::stable_sort(result.errors.begin(), result.errors.end(),
+                   [&](const Diagnostic& a, const Diagnostic& b) {
+                     const auto ra = file_rank(a.where.file);
+                     const auto rb = file_rank(b.where.file);
+                     if (ra != rb) return ra < rb;
+                     if (a.where.line != b.where.line) return a.where.line < b.where.line;
+                     return a.where.column < b.where.column;
+                   });
   if (result.errors.empty()) result.graph = std::move(state.graph);
   return result;
 }

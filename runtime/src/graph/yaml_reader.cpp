@@ -80,15 +80,19 @@ std::optional<std::string> FileReader::substitute(std::string_view text,
     const std::string whole(text.substr(start, end - start + 1));
     if (words.size() == 2 && words[0] == "arg") {
       auto it = args.find(words[1]);
-      if (it == args.end()) {
-        std::vector<std::string> declared;
-        for (const auto& [name, value] : args) declared.push_back(name);
-        diags->error(where, "undefined argument '" + words[1] + "' in '" + whole + "'" +
-                                (declared.empty() ? std::string(" (no args declared in this file)")
-                                                  : " (declared: " + join_quoted(declared) + ")"));
-        ok = false;
-      } else {
+      const bool declared =
+          std::find(declared_args.begin(), declared_args.end(), words[1]) != declared_args.end();
+      if (it != args.end()) {
         out += it->second;
+      } else if (declared) {
+        ok = false;  // declared without a usable value: already reported at the declaration
+      } else {
+        diags->error(where,
+                     "undefined argument '" + words[1] + "' in '" + whole + "'" +
+                         (declared_args.empty() ? std::string(" (no args declared in this file)")
+                                                : did_you_mean(words[1], declared_args) +
+                                                      "; declared: " + join_quoted(declared_args)));
+        ok = false;
       }
     } else if ((words.size() == 2 || words.size() == 3) && words[0] == "env") {
       const char* value = std::getenv(words[1].c_str());
@@ -239,7 +243,7 @@ bool is_identifier(std::string_view name) {
 
 std::string node_kind(const YAML::Node& node) {
   if (!node || node.IsNull()) return "nothing";
-  if (node.IsSequence()) return "a list";
+  if (node.IsSequence()) return node.size() == 0 ? "an empty list" : "a list";
   if (node.IsMap()) return "a mapping";
   return "'" + node.Scalar() + "'";
 }

@@ -33,6 +33,7 @@ class Diagnostics {
 struct FileReader {
   std::string file;
   std::map<std::string, std::string> args;  ///< this file's arguments after overrides
+  std::vector<std::string> declared_args;   ///< in file order, with or without a value
   Diagnostics* diags = nullptr;
 
   /// 1-based location of `node` (yaml-cpp marks are 0-based); 1:1 when unknown.
