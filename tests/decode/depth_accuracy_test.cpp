@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "synthetic_scene.hpp"
+#include "avs/decode/synthetic_plane.hpp"
 
 namespace avs::decode {
 namespace {
@@ -14,7 +14,7 @@ struct Accuracy {
   double rms_m = 0;
 };
 
-Accuracy evaluate(const testing::SyntheticScene& scene, std::span<const float> depth,
+Accuracy evaluate(const SyntheticScene& scene, std::span<const float> depth,
                   const std::vector<int>& codes) {
   Accuracy a;
   double sum_squared = 0;
@@ -52,8 +52,8 @@ Quantisation quantisation(const SensorGeometry& g, const DepthTable& table, int 
   return q;
 }
 
-testing::SceneConfig plane_at_one_metre() {
-  testing::SceneConfig scene;
+PlaneSceneConfig plane_at_one_metre() {
+  PlaneSceneConfig scene;
   scene.plane_depth_m = 1.0;
   scene.noise_sigma = 3.0;
   scene.seed = 2024;
@@ -64,7 +64,7 @@ testing::SceneConfig plane_at_one_metre() {
   return scene;
 }
 
-Accuracy decode_and_report(const DecoderConfig& config, const testing::SyntheticScene& scene,
+Accuracy decode_and_report(const DecoderConfig& config, const SyntheticScene& scene,
                            const char* label, double max_rms_over_uniform = 1.25) {
   RollingDecoder decoder(config);
   DecodeResult result;
@@ -101,14 +101,14 @@ Accuracy decode_and_report(const DecoderConfig& config, const testing::Synthetic
 
 TEST(DepthAccuracy, PlaneAtOneMetreTableTriangulation) {
   DecoderConfig config;
-  const auto scene = testing::render_plane(config.geometry, plane_at_one_metre());
+  const auto scene = render_plane(config.geometry, plane_at_one_metre());
   decode_and_report(config, scene, "ray x plane table");
 }
 
 TEST(DepthAccuracy, PlaneAtOneMetreReferenceSolve) {
   DecoderConfig config;
   config.triangulation = TriangulationMethod::kReferenceSolve;
-  const auto scene = testing::render_plane(config.geometry, plane_at_one_metre());
+  const auto scene = render_plane(config.geometry, plane_at_one_metre());
   decode_and_report(config, scene, "Eq. 4 3x3 solve");
 }
 
@@ -119,7 +119,7 @@ TEST(DepthAccuracy, PlaneAtOneMetreWithLensDistortion) {
   config.geometry.camera.p1 = 0.001;
   config.geometry.projector.k1 = 0.08;
   config.geometry.projector.k2 = -0.02;
-  const auto scene = testing::render_plane(config.geometry, plane_at_one_metre());
+  const auto scene = render_plane(config.geometry, plane_at_one_metre());
   // The fitted planes approximate the curved rows of a distorted projector: a little above
   // pure quantisation noise, still well inside one code step.
   decode_and_report(config, scene, "table, distorted lenses", 1.5);
@@ -128,7 +128,7 @@ TEST(DepthAccuracy, PlaneAtOneMetreWithLensDistortion) {
 TEST(DepthAccuracy, PointMapFollowsDepthAndRays) {
   DecoderConfig config;
   config.compute_point_map = true;
-  const auto scene = testing::render_plane(config.geometry, plane_at_one_metre());
+  const auto scene = render_plane(config.geometry, plane_at_one_metre());
   RollingDecoder decoder(config);
   DecodeResult result;
   for (int k = 0; k < 9; ++k)

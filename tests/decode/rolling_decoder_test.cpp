@@ -4,15 +4,15 @@
 
 #include <gtest/gtest.h>
 
-#include "synthetic_scene.hpp"
+#include "avs/decode/synthetic_plane.hpp"
 
 namespace avs::decode {
 namespace {
 
 constexpr int kBits = 9;
 
-testing::SceneConfig scene_config(std::uint32_t seed, double depth_m = 1.0) {
-  testing::SceneConfig c;
+PlaneSceneConfig scene_config(std::uint32_t seed, double depth_m = 1.0) {
+  PlaneSceneConfig c;
   c.seed = seed;
   c.plane_depth_m = depth_m;
   c.noise_sigma = 4.0;  // enough noise that some pixels are ambiguous
@@ -37,7 +37,7 @@ int count_valid(std::span<const float> depth) {
 
 TEST(RollingDecoder, NineUpdatesEqualTheFullCycleDecode) {
   const DecoderConfig config;
-  const auto scene = testing::render_plane(config.geometry, scene_config(11));
+  const auto scene = render_plane(config.geometry, scene_config(11));
   RollingDecoder decoder(config);
   std::vector<PatternFrame> frames;
   for (int k = 0; k < kBits; ++k) {
@@ -66,8 +66,8 @@ TEST(RollingDecoder, WindowAcrossCyclesEqualsFullDecodeOfTheSameFrames) {
   // moved to 1.02 m): after 9 updates the map is the full decode of exactly those frames.
   DecoderConfig config;
   config.code_correction = true;
-  const auto a = testing::render_plane(config.geometry, scene_config(21, 1.0));
-  const auto b = testing::render_plane(config.geometry, scene_config(22, 1.02));
+  const auto a = render_plane(config.geometry, scene_config(21, 1.0));
+  const auto b = render_plane(config.geometry, scene_config(22, 1.02));
   RollingDecoder decoder(config);
   std::vector<PatternFrame> window;
   DecodeResult result;
@@ -97,7 +97,7 @@ struct DropRun {
 };
 
 DropRun run_with_dropped_negative(DecoderConfig config, int lost_bit) {
-  const auto scene = testing::render_plane(config.geometry, scene_config(31));
+  const auto scene = render_plane(config.geometry, scene_config(31));
   RollingDecoder decoder(config);
   for (int k = 0; k < kBits; ++k) {
     decoder.push_frame(scene.frame(k, Polarity::kPositive, 0));
@@ -150,8 +150,8 @@ TEST(RollingDecoder, OutOfOrderFramesAreNeverAssignedToAnotherBit) {
   // arrive after those of bit 3. If bits were placed by arrival order the codes would be wrong;
   // they must instead be discarded (counted) and the map must keep to the frames' own bits.
   const DecoderConfig config;
-  const auto a = testing::render_plane(config.geometry, scene_config(41, 1.0));
-  const auto b = testing::render_plane(config.geometry, scene_config(42, 1.0));
+  const auto a = render_plane(config.geometry, scene_config(41, 1.0));
+  const auto b = render_plane(config.geometry, scene_config(42, 1.0));
   RollingDecoder decoder(config);
   for (int k = 0; k < kBits; ++k) {
     decoder.push_frame(a.frame(k, Polarity::kPositive, 0));
@@ -190,7 +190,7 @@ TEST(RollingDecoder, OutOfOrderFramesAreNeverAssignedToAnotherBit) {
 
 TEST(RollingDecoder, AfterDisorderTheMapRecoversWithCorrectCodes) {
   const DecoderConfig config;
-  const auto a = testing::render_plane(config.geometry, scene_config(51, 1.0));
+  const auto a = render_plane(config.geometry, scene_config(51, 1.0));
   RollingDecoder decoder(config);
   // Cycle 0 with bits 5 and 6 swapped, cycle 1 in order.
   for (int k : {0, 1, 2, 3, 4, 6, 5, 7, 8}) {

@@ -1,10 +1,10 @@
-#include "synthetic_scene.hpp"
+#include "avs/decode/synthetic_plane.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <random>
 
-namespace avs::decode::testing {
+namespace avs::decode {
 
 PatternFrame SyntheticScene::frame(int bit_index, Polarity polarity, std::int64_t cycle) const {
   const auto& pixels =
@@ -12,7 +12,7 @@ PatternFrame SyntheticScene::frame(int bit_index, Polarity polarity, std::int64_
   return PatternFrame{{pixels.data(), width, height, width}, bit_index, polarity, cycle};
 }
 
-SyntheticScene render_plane(const SensorGeometry& g, const SceneConfig& config) {
+SyntheticScene render_plane(const SensorGeometry& g, const PlaneSceneConfig& config) {
   SyntheticScene scene;
   scene.width = g.camera.width;
   scene.height = g.camera.height;
@@ -21,7 +21,9 @@ SyntheticScene render_plane(const SensorGeometry& g, const SceneConfig& config) 
   scene.true_code.assign(pixels, -1);
   scene.lit.assign(pixels, 0);
   scene.shadowed.assign(pixels, 0);
-  std::vector<int> row_of_pixel(pixels, -1);
+  scene.projector_column.assign(pixels, -1);
+  scene.projector_row.assign(pixels, -1);
+  std::vector<int>& row_of_pixel = scene.projector_row;
   for (int v = 0; v < scene.height; ++v) {
     for (int u = 0; u < scene.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * scene.width + u;
@@ -40,6 +42,7 @@ SyntheticScene render_plane(const SensorGeometry& g, const SceneConfig& config) 
       const int code = code_of_row(g.layout, row);
       if (code < 0) continue;
       row_of_pixel[i] = row;
+      scene.projector_column[i] = column;
       scene.true_code[i] = code;
       scene.lit[i] = 1;
     }
@@ -61,4 +64,4 @@ SyntheticScene render_plane(const SensorGeometry& g, const SceneConfig& config) 
   return scene;
 }
 
-}  // namespace avs::decode::testing
+}  // namespace avs::decode

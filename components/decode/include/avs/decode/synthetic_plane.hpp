@@ -1,5 +1,5 @@
-// Test-only renderer: the Gray-code frames a camera sees of a plane facing the sensor, computed
-// analytically from the same SensorGeometry the decoder uses, with seeded Gaussian noise.
+// Test and benchmark aid (no I/O): the Gray-code frames a camera sees of a plane facing the sensor,
+// computed analytically from the same SensorGeometry the decoder uses, with seeded Gaussian noise.
 #pragma once
 
 #include <cstdint>
@@ -7,9 +7,9 @@
 
 #include "avs/decode/rolling_decoder.hpp"
 
-namespace avs::decode::testing {
+namespace avs::decode {
 
-struct SceneConfig {
+struct PlaneSceneConfig {
   double plane_depth_m = 1.0;  ///< plane z = D in the camera frame
   double ambient = 20;         ///< intensity without projector light
   double amplitude = 180;      ///< added where the projector pixel is on
@@ -27,10 +27,13 @@ struct SyntheticScene {
   std::vector<int> true_code;                     ///< -1 where not lit
   std::vector<std::uint8_t> lit;                  ///< directly lit by a coded projector row
   std::vector<std::uint8_t> shadowed;
+  /// Projector pixel lighting each camera pixel (-1 where not lit), for rendering other patterns.
+  std::vector<int> projector_column;
+  std::vector<int> projector_row;
 
   PatternFrame frame(int bit_index, Polarity polarity, std::int64_t cycle) const;
 };
 
-SyntheticScene render_plane(const SensorGeometry& geometry, const SceneConfig& config);
+SyntheticScene render_plane(const SensorGeometry& geometry, const PlaneSceneConfig& config);
 
-}  // namespace avs::decode::testing
+}  // namespace avs::decode
