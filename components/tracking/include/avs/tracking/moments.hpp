@@ -1,0 +1,50 @@
+// Target observation from a depth image (paper section 5.1): binary mask A from the depth
+// window phi_l < h_c < phi_h (Eq. 8), moments m00, m10, m01 (Eq. 7), centroid m_g (Eq. 9),
+// and the mean target depth X_c used by the image Jacobian (Eq. 15).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+namespace avs::tracking {
+
+struct CameraIntrinsics {
+  double fx_px = 0;
+  double fy_px = 0;
+  double cx_px = 0;
+  double cy_px = 0;
+};
+
+/// Row-major float32 depth image in metres; NaN (or any value outside the window) is not target.
+struct DepthImageView {
+  const float* depth_m = nullptr;
+  int width = 0;
+  int height = 0;
+  std::size_t row_stride_floats = 0;  ///< 0: width
+};
+
+struct MomentsConfig {
+  double depth_min_m = 0.3;  ///< phi_l (Eq. 8)
+  double depth_max_m = 1.5;  ///< phi_h (Eq. 8)
+  double min_area_px = 50;   ///< m00 below this: no target
+};
+
+struct TargetObservation {
+  bool present = false;  ///< m00 >= min_area_px
+  double m00 = 0;        ///< area in pixels (Eq. 7, k = l = 0)
+  double m10 = 0;        ///< sum of x_c over the mask, x_c = u - cx (pixels)
+  double m01 = 0;        ///< sum of y_c over the mask, y_c = v - cy (pixels)
+  /// Centroid m_g = [m10/m00, m01/m00] (Eq. 9) relative to the principal point, pixels.
+  Eigen::Vector2d m_g_px = Eigen::Vector2d::Zero();
+  double centroid_u_px = 0;  ///< m_g in image pixel coordinates (u right, v down)
+  double centroid_v_px = 0;
+  double mean_depth_m = 0;  ///< X_c: mean depth over the mask
+};
+
+/// Eqs. 7-9 over the whole image. Pixel centres are at integer (u, v).
+TargetObservation measure_target(const DepthImageView& depth, const CameraIntrinsics& camera,
+                                 const MomentsConfig& config);
+
+}  // namespace avs::tracking

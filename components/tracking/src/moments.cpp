@@ -1,0 +1,53 @@
+#include "avs/tracking/moments.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace avs::tracking {
+
+TargetObservation measure_target(const DepthImageView& depth, const CameraIntrinsics& camera,
+                                 const MomentsConfig& config) {
+  if (depth.depth_m == nullptr && depth.width * depth.height != 0) {
+    throw std::invalid_argument("measure_target: null depth image of " +
+                                std::to_string(depth.width) + "x" + std::to_string(depth.height));
+  }
+  const std::size_t stride = depth.row_stride_floats != 0 ? depth.row_stride_floats
+                                                          : static_cast<std::size_t>(depth.width);
+  const float lo = static_cast<float>(config.depth_min_m);
+  const float hi = static_cast<float>(config.depth_max_m);
+  // Sums per row in integers/floats, then in double: exact for 512x512 images.
+  double m00 = 0, m10 = 0, m01 = 0, depth_sum = 0;
+  for (int v = 0; v < depth.height; ++v) {
+    const float* row = depth.depth_m + static_cast<std::size_t>(v) * stride;
+    long count = 0;
+    long u_sum = 0;
+    double row_depth = 0;
+    for (int u = 0; u < depth.width; ++u) {
+      const float h = row[u];
+      if (lo < h && h < hi) {  // Eq. 8 (NaN compares false)
+        ++count;
+        u_sum += u;
+        row_depth += h;
+      }
+    }
+    if (count == 0) continue;
+    m00 += static_cast<double>(count);
+    m10 += static_cast<double>(u_sum) - camera.cx_px * static_cast<double>(count);
+    m01 += (v - camera.cy_px) * static_cast<double>(count);
+    depth_sum += row_depth;
+  }
+  TargetObservation obs;
+  obs.m00 = m00;
+  obs.m10 = m10;
+  obs.m01 = m01;
+  if (m00 > 0) {
+    obs.m_g_px = {m10 / m00, m01 / m00};  // Eq. 9
+    obs.centroid_u_px = obs.m_g_px.x() + camera.cx_px;
+    obs.centroid_v_px = obs.m_g_px.y() + camera.cy_px;
+    obs.mean_depth_m = depth_sum / m00;
+  }
+  obs.present = m00 > 0 && m00 >= config.min_area_px;
+  return obs;
+}
+
+}  // namespace avs::tracking
