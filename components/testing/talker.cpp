@@ -18,7 +18,10 @@ class TestTalker final : public runtime::Component {
             .description = "publishes '<seq> <sample address>' strings at rate_hz",
             .parameters = {ParamSpec::real("rate_hz", 100.0, 0.001, 100000.0, "Hz", "publishing rate"),
                            ParamSpec::integer("count", 0, 0, std::nullopt, "",
-                                              "messages to send, 0 = until stopped")},
+                                              "messages to send, 0 = until stopped"),
+                           ParamSpec::integer("fail_after", 0, 0, std::nullopt, "",
+                                              "throw after this many messages (tests failure "
+                                              "reporting and respawn), 0 = never")},
             .publishes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter"),
                           runtime::port<msgs::std_msgs::Float64>("count", "talker_count")},
             .subscribes = {}};
@@ -29,7 +32,8 @@ class TestTalker final : public runtime::Component {
         chatter_(ctx.publisher<msgs::std_msgs::String>("chatter")),
         count_topic_(ctx.publisher<msgs::std_msgs::Float64>("count")),
         period_(static_cast<std::int64_t>(1e9 / ctx.param<double>("rate_hz"))),
-        count_(ctx.param<std::int64_t>("count")) {}
+        count_(ctx.param<std::int64_t>("count")),
+        fail_after_(ctx.param<std::int64_t>("fail_after")) {}
 
   void on_activate() override {
     timer_ = context().create_timer(period_, [this] { tick(); });
@@ -39,6 +43,9 @@ class TestTalker final : public runtime::Component {
  private:
   void tick() {
     if (count_ > 0 && seq_ >= static_cast<std::uint64_t>(count_)) return;
+    if (fail_after_ > 0 && seq_ >= static_cast<std::uint64_t>(fail_after_)) {
+      throw std::runtime_error("failing on purpose after " + std::to_string(seq_) + " messages");
+    }
     auto sample = runtime::make_sample<msgs::std_msgs::String>();
     char text[64];
     std::snprintf(text, sizeof text, "%llu %p", static_cast<unsigned long long>(seq_),
@@ -55,6 +62,7 @@ class TestTalker final : public runtime::Component {
   runtime::Publisher<msgs::std_msgs::Float64> count_topic_;
   runtime::Duration period_;
   std::int64_t count_;
+  std::int64_t fail_after_;
   std::uint64_t seq_ = 0;
   runtime::TimerId timer_ = 0;
 };
