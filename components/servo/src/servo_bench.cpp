@@ -5,6 +5,7 @@
 #include <time.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -123,8 +124,10 @@ bench::Report run_bench(const std::vector<std::string>& args) {
   const LoopFigures peer = run_peer(server.port(), rate_hz, seconds);
 
   bench::Report report;
-  report.title = "servo: Modbus TCP loopback cycle, 2 axes, " + std::to_string(int(rate_hz)) +
-                 " Hz, " + std::to_string(seconds) + " s";
+  char title[128];
+  std::snprintf(title, sizeof title, "servo: Modbus TCP loopback cycle, 2 axes, %.0f Hz, %.1f s",
+                rate_hz, seconds);
+  report.title = title;
   const std::string peer_name = "bare libmodbus 0x17 loop";
   report.rows.push_back(
       {"exchange round trip p50 (per axis)", "us", ours.rtt_us_p50, peer_name, peer.rtt_us_p50});
