@@ -1,0 +1,40 @@
+// Point cloud and camera types shared by the matching core (paper section 6).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace avs::matching {
+
+/// A point cloud: positions in metres, in the frame named by the variable (p_camera, p_model).
+using Points = std::vector<Eigen::Vector3f>;
+
+/// Pinhole intrinsics of the depth camera (pixels); the camera looks along +z.
+struct CameraIntrinsics {
+  float fx_px = 900.0F;
+  float fy_px = 900.0F;
+  float cx_px = 255.5F;
+  float cy_px = 255.5F;
+  int width_px = 512;
+  int height_px = 512;
+};
+
+/// A depth image borrowed from its owner: depth_m[v * stride + u] is the z of pixel (u, v) in
+/// metres, 0 (or non-finite) where no 3-D value was measured.
+struct DepthView {
+  const float* depth_m = nullptr;
+  int width_px = 0;
+  int height_px = 0;
+  int stride_px = 0;  ///< elements per row; 0 means width_px
+};
+
+/// Optional target mask, same layout as the depth image: non-zero = pixel belongs to the target.
+struct MaskView {
+  const std::uint8_t* mask = nullptr;  ///< nullptr: every pixel with depth is used
+  int stride_px = 0;                   ///< 0 means the depth image's width
+};
+
+}  // namespace avs::matching

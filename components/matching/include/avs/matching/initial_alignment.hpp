@@ -1,0 +1,82 @@
+// Initial (global) alignment by local reference frames (paper section 6.1, Eqs. 17-20), then
+// verification: the best LRF-pair hypotheses are refined by ICP and re-scored on the whole
+// S-PCD, so a flipped match (the ken's big cup on its small cup) loses to the right one.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "avs/matching/cloud.hpp"
+#include "avs/matching/features.hpp"
+#include "avs/matching/icp.hpp"
+#include "avs/matching/model_cloud.hpp"
+
+namespace avs::matching {
+
+struct InitialAlignmentConfig {
+  FeatureConfig scene_features;       ///< radius 0 = 2.5 x the model's mean point spacing
+  FeatureConfig model_features;       ///< radius 0 = 2.5 x the model's mean point spacing
+  float scene_lrf_rate = 0.1F;        ///< scene LRFs kept (paper: 0.1) ...
+  std::size_t min_scene_lrfs = 12;    ///< ... but at least this many when available
+  std::size_t score_points = 40;      ///< scene points that score each hypothesis
+  float score_truncation_m = 0.02F;   ///< closest-point distances are clamped to this
+  std::size_t refine_candidates = 6;  ///< best distinct hypotheses refined by ICP
+  std::array<int, 3> refine_iterations{6, 6, 12};
+  IcpMetric refine_metric = IcpMetric::point_to_plane;
+  float verify_truncation_m = 0.01F;  ///< truncation of the final scores
+  /// Weight of the visibility term: mean distance from the model points the refined pose shows
+  /// to the camera to their closest scene points. It tells the ken's big cup from its small cup.
+  float visibility_weight = 0.5F;
+  std::array<int, 3> verify_iterations{0, 0, 5};  ///< ICP on the dense model before scoring
+  /// The best few hypotheses are also tried turned by 180 degrees about each principal axis of
+  /// the model (through its centroid): the end-for-end flips LRFs confuse.
+  std::size_t flip_candidates = 2;
+  std::uint32_t seed = 1;  ///< for the LRF down-sampling
+};
+
+struct InitialAlignmentResult {
+  Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+  float score_m = 0.0F;  ///< verification score of the chosen, refined pose (lower is better)
+  float rmse_m = 0.0F;   ///< ICP residual of the chosen pose
+  std::size_t scene_lrfs = 0;
+  std::size_t model_lrfs = 0;
+  std::size_t hypotheses = 0;  ///< LRF pairs scored
+  bool valid = false;          ///< false when the scene has too few points or LRFs
+};
+
+/// Holds the model's features and LRFs (computed once) and aligns scenes to it.
+class InitialAligner {
+ public:
+  explicit InitialAligner(const ModelCloud& model, InitialAlignmentConfig config = {});
+
+  [[nodiscard]] InitialAlignmentResult align(const Points& p_camera);
+
+  [[nodiscard]] const std::vector<Lrf>& model_lrfs() const { return model_lrfs_; }
+  /// LRFs of the last scene (all, and the down-sampled ones used), for figures.
+  [[nodiscard]] const std::vector<Lrf>& scene_lrfs() const { return scene_lrfs_; }
+  [[nodiscard]] const std::vector<Lrf>& scene_lrfs_used() const { return scene_lrfs_used_; }
+  [[nodiscard]] const InitialAlignmentConfig& config() const { return config_; }
+
+ private:
+  struct Hypothesis {
+    Eigen::Isometry3f T_model_camera;
+    float score;
+  };
+  [[nodiscard]] float score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
+                            const Eigen::Isometry3f& T_model_camera, float give_up_above) const;
+
+  InitialAlignmentConfig config_;
+  KdTree model_tree_;
+  KdTree dense_tree_;  // dense samples (the M-PCD itself when the model has none)
+  Points dense_normals_;
+  std::array<Eigen::Isometry3f, 3> flips_model_;  // 180-degree turns about the principal axes
+  std::vector<Lrf> model_lrfs_;
+  std::vector<Lrf> scene_lrfs_;
+  std::vector<Lrf> scene_lrfs_used_;
+  Icp refine_;
+  Icp verify_;
+};
+
+}  // namespace avs::matching

@@ -1,0 +1,69 @@
+// Frame-to-frame tracking: initial alignment on the first observation, then ICP from the
+// previous pose (optionally predicted at constant velocity), loss detection by RMSE and inlier
+// ratio, re-initialisation after a loss.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "avs/matching/icp.hpp"
+#include "avs/matching/initial_alignment.hpp"
+#include "avs/matching/model_cloud.hpp"
+
+namespace avs::matching {
+
+struct TrackerConfig {
+  /// Per-frame ICP: [0, 0, 1] as in the paper, point-to-plane (point-to-point on a few hundred
+  /// model points keeps about a degree of bias, see docs/matching.md).
+  IcpConfig icp = {.iterations = {0, 0, 1}, .metric = IcpMetric::point_to_plane};
+  InitialAlignmentConfig initial;     ///< used on the first frame and after a loss
+  bool constant_velocity = true;      ///< predict from the last two poses
+  float max_rmse_m = 0.0F;            ///< above this the frame fails; 0 = model's mean spacing
+  float min_inlier_ratio = 0.5F;      ///< below this the frame is a failure
+  int failures_before_loss = 3;       ///< consecutive failures that declare the target lost
+  std::size_t min_scene_points = 15;  ///< fewer: no update (counts as a failure)
+};
+
+enum class TrackingState { waiting, tracking, lost };
+
+[[nodiscard]] const char* to_string(TrackingState state);
+
+struct TrackResult {
+  Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+  TrackingState state = TrackingState::waiting;
+  bool initialised_this_frame = false;  ///< the initial alignment ran on this frame
+  bool pose_valid = false;              ///< this frame passed the RMSE / inlier checks
+  IcpResult icp;                        ///< of this frame
+};
+
+class Tracker {
+ public:
+  Tracker(const ModelCloud& model, TrackerConfig config = {});
+
+  /// One S-PCD (camera frame). stamp_s is used for the constant-velocity prediction.
+  TrackResult update(const Points& p_camera, double stamp_s);
+
+  /// Forget the target: the next frame runs the initial alignment.
+  void reset();
+
+  [[nodiscard]] TrackingState state() const { return state_; }
+  [[nodiscard]] const InitialAlignmentResult& last_initial_alignment() const {
+    return last_initial_;
+  }
+
+ private:
+  [[nodiscard]] Eigen::Isometry3f predict(double stamp_s) const;
+
+  TrackerConfig config_;
+  Icp icp_;
+  InitialAligner initial_;
+  TrackingState state_ = TrackingState::waiting;
+  int failures_ = 0;
+  std::optional<Eigen::Isometry3f> last_pose_;
+  std::optional<Eigen::Isometry3f> previous_pose_;
+  double last_stamp_s_ = 0.0;
+  double previous_stamp_s_ = 0.0;
+  InitialAlignmentResult last_initial_;
+};
+
+}  // namespace avs::matching

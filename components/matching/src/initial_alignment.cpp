@@ -1,0 +1,195 @@
+#include "avs/matching/initial_alignment.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+
+namespace avs::matching {
+namespace {
+
+FeatureConfig with_radius(FeatureConfig config, float spacing_m) {
+  if (!(config.neighbourhood_radius_m > 0.0F)) config.neighbourhood_radius_m = 2.5F * spacing_m;
+  return config;
+}
+
+IcpConfig refine_config(const InitialAlignmentConfig& config) {
+  IcpConfig icp;
+  icp.iterations = config.refine_iterations;
+  icp.max_correspondence_distance_m = config.score_truncation_m;
+  icp.metric = config.refine_metric;
+  return icp;
+}
+
+// Eq. 20: T [L_s p; 0 1] = [L_m q; 0 1]  =>  T = [L_m L_s^T, q - L_m L_s^T p], scene -> model.
+Eigen::Isometry3f lrf_transform(const Lrf& scene, const Lrf& model) {
+  Eigen::Isometry3f t = Eigen::Isometry3f::Identity();
+  t.linear() = model.axes * scene.axes.transpose();
+  t.translation() = model.origin_m - t.linear() * scene.origin_m;
+  return t;
+}
+
+bool similar(const Eigen::Isometry3f& a, const Eigen::Isometry3f& b) {
+  const Eigen::Matrix3f d = a.linear().transpose() * b.linear();
+  return (a.translation() - b.translation()).norm() < 0.01F &&
+         d.trace() > 1.0F + 2.0F * std::cos(0.2F);
+}
+
+}  // namespace
+
+InitialAligner::InitialAligner(const ModelCloud& model, InitialAlignmentConfig config)
+    : config_(config),
+      model_tree_(model.points_m),
+      dense_tree_(model.dense_points_m.empty() ? model.points_m : model.dense_points_m),
+      dense_normals_(model.dense_points_m.empty() ? model.normals : model.dense_normals),
+      refine_(model.points_m, refine_config(config), model.normals),
+      verify_(
+          dense_tree_.points(),
+          [&] {
+            IcpConfig icp = refine_config(config);
+            icp.iterations = config.verify_iterations;
+            return icp;
+          }(),
+          dense_normals_) {
+  config_.scene_features = with_radius(config_.scene_features, model.mean_spacing_m);
+  config_.model_features = with_radius(config_.model_features, model.mean_spacing_m);
+  // Principal axes of the model through its centroid, for the flip candidates.
+  Eigen::Vector3f centroid = Eigen::Vector3f::Zero();
+  for (const auto& p : model.points_m) centroid += p;
+  centroid /= static_cast<float>(std::max<std::size_t>(1, model.points_m.size()));
+  Eigen::Matrix3f covariance = Eigen::Matrix3f::Zero();
+  for (const auto& p : model.points_m)
+    covariance.noalias() += (p - centroid) * (p - centroid).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3f> principal(covariance);
+  for (int axis = 0; axis < 3; ++axis) {
+    Eigen::Isometry3f flip = Eigen::Isometry3f::Identity();
+    flip.linear() = Eigen::AngleAxisf(std::numbers::pi_v<float>, principal.eigenvectors().col(axis))
+                        .toRotationMatrix();
+    flip.translation() = centroid - flip.linear() * centroid;
+    flips_model_[static_cast<std::size_t>(axis)] = flip;
+  }
+  NormalOrientation outward;
+  outward.reference_normals = &model.normals;
+  const PointFeatures features =
+      compute_features(model.points_m, model_tree_, config_.model_features, outward);
+  model_lrfs_ = compute_lrfs(model.points_m, features, config_.model_features);
+}
+
+float InitialAligner::score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
+                            const Eigen::Isometry3f& T_model_camera, float give_up_above) const {
+  const float truncation_squared = config_.score_truncation_m * config_.score_truncation_m;
+  float sum = 0.0F;
+  for (const auto i : subset) {
+    const auto [index, squared] = model_tree_.nearest(T_model_camera * p_camera[i]);
+    sum += std::sqrt(std::min(squared, truncation_squared));
+    if (sum > give_up_above) return std::numeric_limits<float>::infinity();
+  }
+  return sum;
+}
+
+InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
+  InitialAlignmentResult result;
+  scene_lrfs_.clear();
+  scene_lrfs_used_.clear();
+  if (p_camera.size() < 10 || model_lrfs_.empty()) return result;
+
+  // 1. Scene features and LRFs (normals toward the camera at the origin).
+  const KdTree scene_tree(p_camera);
+  const PointFeatures features = compute_features(p_camera, scene_tree, config_.scene_features, {});
+  scene_lrfs_ = compute_lrfs(p_camera, features, config_.scene_features);
+  if (scene_lrfs_.empty()) return result;
+
+  // 2. Down-sample the scene LRFs (rate 0.1 in the paper), seeded and without repetition.
+  std::vector<std::size_t> order(scene_lrfs_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::mt19937 rng(config_.seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  const auto wanted = std::max<std::size_t>(
+      config_.min_scene_lrfs,
+      static_cast<std::size_t>(
+          std::ceil(config_.scene_lrf_rate * static_cast<float>(scene_lrfs_.size()))));
+  order.resize(std::min(order.size(), wanted));
+  for (const auto i : order) scene_lrfs_used_.push_back(scene_lrfs_[i]);
+
+  // 3. Score every scene/model LRF pair by summed (truncated) closest-point distances on an
+  //    evenly spread subset of the scene; keep the best few distinct hypotheses.
+  std::vector<std::uint32_t> subset;
+  const std::size_t step = std::max<std::size_t>(1, p_camera.size() / config_.score_points);
+  for (std::size_t i = 0; i < p_camera.size(); i += step)
+    subset.push_back(static_cast<std::uint32_t>(i));
+  std::vector<Hypothesis> best;  // sorted ascending by score, at most refine_candidates * 4
+  const std::size_t keep = std::max<std::size_t>(1, config_.refine_candidates) * 4;
+  for (const auto& scene : scene_lrfs_used_) {
+    for (const auto& model : model_lrfs_) {
+      const Eigen::Isometry3f T_model_camera = lrf_transform(scene, model);
+      const float limit =
+          best.size() < keep ? std::numeric_limits<float>::infinity() : best.back().score;
+      const float s = score(p_camera, subset, T_model_camera, limit);
+      ++result.hypotheses;
+      if (!(s < limit)) continue;
+      const auto at =
+          std::lower_bound(best.begin(), best.end(), s,
+                           [](const Hypothesis& h, float value) { return h.score < value; });
+      best.insert(at, {T_model_camera, s});
+      if (best.size() > keep) best.pop_back();
+    }
+  }
+  result.scene_lrfs = scene_lrfs_used_.size();
+  result.model_lrfs = model_lrfs_.size();
+  if (best.empty()) return result;
+
+  // 4. Verify: refine distinct top hypotheses by ICP; score each by the mean truncated distance
+  //    from every scene point to the model plus the mean truncated distance from every model
+  //    point facing the camera to the scene (what the pose predicts must be seen), keep the best.
+  std::vector<Eigen::Isometry3f> distinct;
+  for (const auto& h : best) {
+    if (distinct.size() >= config_.refine_candidates) break;
+    if (std::none_of(distinct.begin(), distinct.end(),
+                     [&](const auto& d) { return similar(d, h.T_model_camera); })) {
+      distinct.push_back(h.T_model_camera);
+    }
+  }
+  const std::size_t unflipped = distinct.size();
+  for (std::size_t c = 0; c < std::min(config_.flip_candidates, unflipped); ++c) {
+    // T_model_camera of a flipped pose: flip^-1 applied in the model frame.
+    for (const auto& flip : flips_model_) distinct.push_back(flip.inverse() * distinct[c]);
+  }
+  const float verify_squared = config_.verify_truncation_m * config_.verify_truncation_m;
+  float best_score = std::numeric_limits<float>::infinity();
+  for (const auto& T_model_camera : distinct) {
+    const IcpResult coarse = refine_.align(p_camera, T_model_camera.inverse());
+    const IcpResult refined = verify_.align(p_camera, coarse.T_camera_model);
+    const Eigen::Isometry3f T_camera_model = refined.T_camera_model;
+    const Eigen::Isometry3f T_refined = T_camera_model.inverse();
+    float sum = 0.0F;
+    for (const auto& p : p_camera) {
+      sum += std::sqrt(std::min(dense_tree_.nearest(T_refined * p).second, verify_squared));
+    }
+    float mean = sum / static_cast<float>(p_camera.size());
+    if (config_.visibility_weight > 0.0F) {
+      float visible_sum = 0.0F;
+      std::size_t visible = 0;
+      for (std::size_t i = 0; i < dense_tree_.size(); ++i) {
+        const Eigen::Vector3f p = T_camera_model * dense_tree_.points()[i];
+        if ((T_camera_model.linear() * dense_normals_[i]).dot(p) >= 0.0F) continue;  // faces away
+        visible_sum += std::sqrt(std::min(scene_tree.nearest(p).second, verify_squared));
+        ++visible;
+      }
+      if (visible > 0)
+        mean += config_.visibility_weight * visible_sum / static_cast<float>(visible);
+    }
+    if (mean < best_score) {
+      best_score = mean;
+      result.T_camera_model = T_camera_model;
+      result.rmse_m = refined.rmse_m;
+    }
+  }
+  result.score_m = best_score;
+  result.valid = true;
+  return result;
+}
+
+}  // namespace avs::matching

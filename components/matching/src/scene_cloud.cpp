@@ -1,0 +1,109 @@
+#include "avs/matching/scene_cloud.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "avs/matching/kd_tree.hpp"
+
+namespace avs::matching {
+namespace {
+
+bool usable(float z, const SceneCloudConfig& config) {
+  return std::isfinite(z) && z >= config.min_depth_m && z <= config.max_depth_m;
+}
+
+void remove_outliers_into(const Points& in, std::size_t neighbours, float threshold_m, Points& out,
+                          std::vector<std::uint32_t>& indices, std::vector<float>& squared) {
+  out.clear();
+  if (in.size() <= 1 || neighbours == 0) {
+    out = in;
+    return;
+  }
+  const KdTree tree(in);  // small (a few hundred points); the build is a few microseconds
+  indices.resize(neighbours + 1);
+  squared.resize(neighbours + 1);
+  for (const auto& p : in) {
+    const std::size_t found = tree.knn(p, neighbours + 1, indices.data(), squared.data());
+    double sum = 0.0;
+    for (std::size_t k = 1; k < found; ++k) sum += std::sqrt(static_cast<double>(squared[k]));
+    const double mean = found > 1 ? sum / static_cast<double>(found - 1) : 0.0;
+    if (mean <= static_cast<double>(threshold_m)) out.push_back(p);
+  }
+}
+
+}  // namespace
+
+double stride_ratio(std::size_t valid_pixels, std::size_t target_points) {
+  // Eq. 27: C_p = M / i_number if M > i_number, else 1.
+  if (target_points == 0 || valid_pixels <= target_points) return 1.0;
+  return static_cast<double>(valid_pixels) / static_cast<double>(target_points);
+}
+
+const Points& SceneCloudBuilder::build(const DepthView& depth, const MaskView& mask,
+                                       const CameraIntrinsics& camera) {
+  if (depth.depth_m == nullptr || depth.width_px <= 0 || depth.height_px <= 0) {
+    throw std::invalid_argument("SceneCloudBuilder::build: empty depth image");
+  }
+  const int stride = depth.stride_px > 0 ? depth.stride_px : depth.width_px;
+  const int mask_stride = mask.stride_px > 0 ? mask.stride_px : depth.width_px;
+  auto valid = [&](int u, int v) {
+    if (mask.mask != nullptr &&
+        mask.mask[static_cast<std::size_t>(v) * static_cast<std::size_t>(mask_stride) +
+                  static_cast<std::size_t>(u)] == 0) {
+      return false;
+    }
+    return usable(depth.depth_m[static_cast<std::size_t>(v) * static_cast<std::size_t>(stride) +
+                                static_cast<std::size_t>(u)],
+                  config_);
+  };
+
+  // 1. Count the valid target pixels M.
+  valid_pixels_ = 0;
+  for (int v = 0; v < depth.height_px; ++v) {
+    for (int u = 0; u < depth.width_px; ++u) valid_pixels_ += valid(u, v) ? 1U : 0U;
+  }
+
+  // 2. Keep the (i * C_p)-th valid pixel, i = 1, 2, ... (Eq. 27), back-projected to 3-D.
+  const double ratio = stride_ratio(valid_pixels_, config_.target_points);
+  sampled_.clear();
+  std::size_t index = 0;
+  double next = ratio - 1.0;  // 0-based index of the next pixel to keep
+  for (int v = 0; v < depth.height_px; ++v) {
+    for (int u = 0; u < depth.width_px; ++u) {
+      if (!valid(u, v)) continue;
+      if (static_cast<double>(index) >= next) {
+        const float z =
+            depth.depth_m[static_cast<std::size_t>(v) * static_cast<std::size_t>(stride) +
+                          static_cast<std::size_t>(u)];
+        sampled_.emplace_back((static_cast<float>(u) - camera.cx_px) * z / camera.fx_px,
+                              (static_cast<float>(v) - camera.cy_px) * z / camera.fy_px, z);
+        next += ratio;
+      }
+      ++index;
+    }
+  }
+
+  // 3. Voxel down-sampling with side r, centroid per voxel.
+  if (config_.voxel_size_m > 0.0F) {
+    voxel_downsample(sampled_, config_.voxel_size_m, voxels_, scratch_);
+  } else {
+    voxels_ = sampled_;
+  }
+
+  // 4. Outliers: mean distance to the k nearest neighbours above the threshold.
+  remove_outliers_into(voxels_, config_.outlier_neighbours, config_.outlier_mean_distance_m,
+                       result_, knn_indices_, knn_squared_);
+  return result_;
+}
+
+Points remove_outliers(const Points& points, std::size_t neighbours,
+                       float mean_distance_threshold_m) {
+  Points out;
+  std::vector<std::uint32_t> indices;
+  std::vector<float> squared;
+  remove_outliers_into(points, neighbours, mean_distance_threshold_m, out, indices, squared);
+  return out;
+}
+
+}  // namespace avs::matching

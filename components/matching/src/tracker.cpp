@@ -1,0 +1,105 @@
+#include "avs/matching/tracker.hpp"
+
+#include <cmath>
+
+namespace avs::matching {
+
+const char* to_string(TrackingState state) {
+  switch (state) {
+    case TrackingState::waiting:
+      return "waiting";
+    case TrackingState::tracking:
+      return "tracking";
+    case TrackingState::lost:
+      return "lost";
+  }
+  return "unknown";
+}
+
+Tracker::Tracker(const ModelCloud& model, TrackerConfig config)
+    : config_(config),
+      icp_(model.points_m, config.icp, model.normals),
+      initial_(model, config.initial) {
+  if (!(config_.max_rmse_m > 0.0F)) config_.max_rmse_m = icp_.model_spacing_m();
+}
+
+void Tracker::reset() {
+  state_ = TrackingState::waiting;
+  failures_ = 0;
+  last_pose_.reset();
+  previous_pose_.reset();
+}
+
+Eigen::Isometry3f Tracker::predict(double stamp_s) const {
+  if (!config_.constant_velocity || !previous_pose_ || last_stamp_s_ <= previous_stamp_s_)
+    return *last_pose_;
+  // Constant velocity: apply the last inter-frame motion, scaled to the elapsed time.
+  const Eigen::Isometry3f delta = *last_pose_ * previous_pose_->inverse();
+  const double scale = (stamp_s - last_stamp_s_) / (last_stamp_s_ - previous_stamp_s_);
+  if (!(scale > 0.0) || scale > 4.0) return *last_pose_;
+  const Eigen::AngleAxisf rotation(delta.linear());
+  Eigen::Isometry3f scaled = Eigen::Isometry3f::Identity();
+  scaled.linear() = Eigen::AngleAxisf(rotation.angle() * static_cast<float>(scale), rotation.axis())
+                        .toRotationMatrix();
+  scaled.translation() = delta.translation() * static_cast<float>(scale);
+  return scaled * *last_pose_;
+}
+
+TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
+  TrackResult result;
+  if (p_camera.size() < config_.min_scene_points) {
+    if (state_ == TrackingState::tracking && ++failures_ >= config_.failures_before_loss) {
+      state_ = TrackingState::lost;
+    }
+    result.state = state_;
+    if (last_pose_) result.T_camera_model = *last_pose_;
+    return result;
+  }
+
+  // 1. Pose guess: initial alignment when not tracking, else prediction from the last poses.
+  Eigen::Isometry3f guess;
+  if (state_ != TrackingState::tracking) {
+    last_initial_ = initial_.align(p_camera);
+    result.initialised_this_frame = true;
+    if (!last_initial_.valid) {
+      result.state = state_;
+      return result;
+    }
+    guess = last_initial_.T_camera_model;
+    previous_pose_.reset();
+  } else {
+    guess = predict(stamp_s);
+  }
+
+  // 2. Fixed-count ICP from the guess.
+  result.icp = icp_.align(p_camera, guess);
+  result.T_camera_model = result.icp.T_camera_model;
+  result.pose_valid = result.icp.valid && result.icp.rmse_m <= config_.max_rmse_m &&
+                      result.icp.inlier_ratio() >= config_.min_inlier_ratio;
+
+  // 3. State machine: failures in a row declare the target lost; a lost target re-initialises.
+  if (result.pose_valid) {
+    failures_ = 0;
+    state_ = TrackingState::tracking;
+    previous_pose_ = last_pose_;
+    previous_stamp_s_ = last_stamp_s_;
+    last_pose_ = result.T_camera_model;
+    last_stamp_s_ = stamp_s;
+  } else if (state_ == TrackingState::tracking) {
+    if (++failures_ >= config_.failures_before_loss) {
+      state_ = TrackingState::lost;
+      previous_pose_.reset();
+    } else {
+      previous_pose_ = last_pose_;
+      previous_stamp_s_ = last_stamp_s_;
+      last_pose_ = result.T_camera_model;
+      last_stamp_s_ = stamp_s;
+    }
+  } else {
+    state_ = TrackingState::lost;
+  }
+  result.state = state_;
+  return result;
+}
+
+}  // namespace avs::matching

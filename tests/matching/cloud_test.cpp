@@ -1,0 +1,120 @@
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "avs/matching/model_cloud.hpp"
+#include "avs/matching/scene_cloud.hpp"
+#include "avs/matching/synthetic.hpp"
+#include "avs/matching/voxel_grid.hpp"
+#include "scene_fixture.hpp"
+
+namespace avs::matching {
+namespace {
+
+// Distance from a point (model frame) to the surface of a cube of side s centred on the origin.
+float cube_surface_distance(const Eigen::Vector3f& p, float side) {
+  const Eigen::Vector3f q = p.cwiseAbs() - Eigen::Vector3f::Constant(side / 2);
+  const float outside = q.cwiseMax(0.0F).norm();
+  const float inside = std::min(q.maxCoeff(), 0.0F);
+  return std::abs(outside + inside);
+}
+
+TEST(VoxelGrid, KeepsOneCentroidPerVoxel) {
+  const Points in{{0.001F, 0.001F, 0.001F}, {0.003F, 0.003F, 0.003F}, {0.012F, 0.001F, 0.001F}};
+  const Points out = voxel_downsample(in, 0.01F);
+  ASSERT_EQ(out.size(), 2U);
+  EXPECT_TRUE(out[0].isApprox(Eigen::Vector3f(0.002F, 0.002F, 0.002F)) ||
+              out[1].isApprox(Eigen::Vector3f(0.002F, 0.002F, 0.002F)));
+}
+
+TEST(ModelCloud, SamplesLieOnTheSurfaceAndAreSeeded) {
+  const auto mesh = make_cube_mesh(0.1F);
+  const SurfaceSamples a = sample_surface(mesh, 2000, 7);
+  const SurfaceSamples b = sample_surface(mesh, 2000, 7);
+  ASSERT_EQ(a.points_m.size(), 2000U);
+  for (std::size_t i = 0; i < a.points_m.size(); ++i) {
+    EXPECT_LT(cube_surface_distance(a.points_m[i], 0.1F), 1e-5F);
+    EXPECT_EQ(a.points_m[i], b.points_m[i]);
+    // Outward normal: points away from the centre.
+    EXPECT_GT(a.normals[i].dot(a.points_m[i]), 0.0F);
+  }
+  // Area weighting: each of the 6 faces gets about 1/6 of the samples.
+  int top = 0;
+  for (const auto& p : a.points_m) top += p.z() > 0.0499F ? 1 : 0;
+  EXPECT_NEAR(top, 2000 / 6, 60);
+}
+
+TEST(ModelCloud, ReachesThePaperCounts) {
+  for (const auto& object : builtin_objects()) {
+    const ModelCloud model = test::model_of(object);
+    const auto wanted = static_cast<double>(object.model_points);
+    EXPECT_NEAR(static_cast<double>(model.points_m.size()), wanted, 0.03 * wanted) << object.name;
+    EXPECT_EQ(model.normals.size(), model.points_m.size());
+    EXPECT_GT(model.voxel_size_m, 0.0F);
+    EXPECT_GT(model.mean_spacing_m, 0.0F);
+  }
+}
+
+TEST(SceneCloud, StrideRatioFollowsEq27) {
+  EXPECT_DOUBLE_EQ(stride_ratio(1000, 250), 4.0);
+  EXPECT_DOUBLE_EQ(stride_ratio(100, 250), 1.0);
+  EXPECT_DOUBLE_EQ(stride_ratio(250, 250), 1.0);
+}
+
+TEST(SceneCloud, RenderedCubeFaceHasTheRightDepth) {
+  Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+  T_camera_model.translation() = Eigen::Vector3f(0.0F, 0.0F, 0.5F);
+  const CameraIntrinsics camera;
+  const DepthImage depth = render_depth(make_cube_mesh(0.1F), T_camera_model, camera);
+  EXPECT_NEAR(depth.depth_m[256 * 512 + 256], 0.45F, 1e-5F);
+  EXPECT_EQ(depth.depth_m[0], 0.0F);
+  // The face spans 0.1 m at 0.45 m: about (900 * 0.1 / 0.45)^2 pixels.
+  EXPECT_NEAR(static_cast<double>(depth.valid_pixels()), std::pow(900.0 * 0.1 / 0.45, 2.0), 1500.0);
+}
+
+TEST(SceneCloud, PointsLieOnTheObservedSurface) {
+  const ObjectPreset cube = builtin_objects()[1];
+  const ModelCloud model = test::model_of(cube);
+  const Eigen::Isometry3f T_camera_model = random_object_pose(3);
+  const Points scene = test::scene_of(cube, model, T_camera_model, 3);
+  ASSERT_GT(scene.size(), 40U);
+  ASSERT_LT(scene.size(), 400U);
+  const Eigen::Isometry3f T_model_camera = T_camera_model.inverse();
+  for (const auto& p : scene) {
+    // Voxel centroids of a curved-over edge can sit inside by up to about half a voxel.
+    EXPECT_LT(cube_surface_distance(T_model_camera * p, 0.1F), 0.5F * model.voxel_size_m);
+  }
+}
+
+TEST(SceneCloud, MaskSelectsPixels) {
+  const ObjectPreset cube = builtin_objects()[1];
+  Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+  T_camera_model.translation() = Eigen::Vector3f(0.0F, 0.0F, 0.5F);
+  const CameraIntrinsics camera;
+  const DepthImage depth = render_depth(cube.mesh, T_camera_model, camera);
+  std::vector<std::uint8_t> mask(depth.depth_m.size(), 0);
+  for (int v = 0; v < 512; ++v) {
+    for (int u = 0; u < 256; ++u)
+      mask[static_cast<std::size_t>(v * 512 + u)] = 1;  // left half only
+  }
+  SceneCloudBuilder builder(SceneCloudConfig{});
+  const Points& scene = builder.build(depth.view(), {mask.data(), 0}, camera);
+  ASSERT_FALSE(scene.empty());
+  for (const auto& p : scene) EXPECT_LT(p.x(), 0.001F);
+  EXPECT_LT(builder.valid_pixels(), depth.valid_pixels() / 2 + 600);
+}
+
+TEST(SceneCloud, RemovesIsolatedPoints) {
+  Points points;
+  for (int i = 0; i < 10; ++i) {
+    for (int j = 0; j < 10; ++j)
+      points.emplace_back(0.005F * static_cast<float>(i), 0.005F * static_cast<float>(j), 0.5F);
+  }
+  points.emplace_back(0.3F, 0.3F, 0.8F);
+  const Points kept = remove_outliers(points, 20, 0.03F);
+  EXPECT_EQ(kept.size(), 100U);
+  for (const auto& p : kept) EXPECT_LT(p.z(), 0.6F);
+}
+
+}  // namespace
+}  // namespace avs::matching
