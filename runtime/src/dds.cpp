@@ -15,8 +15,31 @@ int effective_domain(int configured) {
   return static_cast<int>(id);
 }
 
+namespace {
+
+// Cyclone's default writer history cache (WhcHigh 500 KiB) holds fewer than two 512x512
+// images and throttles a 1 kHz image writer; 8 MB removed those stalls and losses
+// (../shared/reference/dds-cyclone-notes.md). Used only when CYCLONEDDS_URI is not set.
+constexpr const char* kDefaultConfig =
+    "<CycloneDDS><Domain id=\"any\"><Internal><Watermarks><WhcHigh>8MB</WhcHigh></Watermarks>"
+    "</Internal></Domain></CycloneDDS>";
+
+dds_domainid_t prepare_domain(dds_domainid_t domain) {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (uri != nullptr && *uri != '\0') return domain;
+  // The domain lives as long as the process, like Cyclone's implicit default domain; a
+  // second participant in the same process finds it already created.
+  const dds_entity_t created = dds_create_domain(domain, kDefaultConfig);
+  if (created < 0 && created != DDS_RETCODE_PRECONDITION_NOT_MET) {
+    check_dds(created, "create DDS domain " + std::to_string(domain));
+  }
+  return domain;
+}
+
+}  // namespace
+
 Participant::Participant(dds_domainid_t domain)
-    : Entity(check_dds(dds_create_participant(domain, nullptr, nullptr),
+    : Entity(check_dds(dds_create_participant(prepare_domain(domain), nullptr, nullptr),
                        "create DDS participant on domain " + std::to_string(domain))) {}
 
 Topic::Topic(const Participant& participant, const dds_topic_descriptor_t* descriptor,

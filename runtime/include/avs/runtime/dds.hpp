@@ -48,7 +48,7 @@ class Entity {
 /// Domain participant. `config_xml` may be empty (Cyclone then reads CYCLONEDDS_URI).
 class Participant : public Entity {
  public:
-  explicit Participant(dds_domainid_t domain = DDS_DOMAIN_DEFAULT);
+  explicit Participant(dds_domainid_t domain = 0);
 };
 
 class Topic : public Entity {
