@@ -327,6 +327,8 @@ Container::~Container() = default;
 
 void Container::stop() { impl_->scheduler->stop(); }
 
+Time Container::now() const { return impl_->scheduler->now(); }
+
 Component* Container::find_component(const std::string& name) const {
   for (const auto& host : impl_->hosts) {
     if (host->instance().name == name) return host->component.get();

@@ -33,6 +33,9 @@ class Container {
 
   const std::string& name() const { return spec_.name; }
 
+  /// The container's clock (sim or wall time); thread-safe.
+  Time now() const;
+
   /// The component instance named `name` (after run() has constructed it), for tests.
   Component* find_component(const std::string& name) const;
 
