@@ -1,0 +1,115 @@
+// Projector-camera renderer core (issue 3 item 1): what the paper's camera sees while the
+// projector shows one Gray-code pattern (section 4.1, Eq. 1). Plain C++ over Eigen, no I/O.
+//
+// Two passes. set_view() runs once per pose: it rasterises every mesh into the camera's and
+// the projector's depth buffers and stores, per camera pixel, the visible surface point, its
+// shading and the Gray code of the projector row that lights it (none when the projector
+// does not see the point: projector shadow). shade() runs once per frame: pattern bit
+// lookup, intensity = albedo x (ambient + projector x bit x shading) + noise, clipped to
+// 8 bits.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "avs/decode/sensor_geometry.hpp"
+#include "avs/geometry/mesh.hpp"
+#include "avs/sim/rasterizer.hpp"
+
+namespace avs::sim {
+
+struct RendererConfig {
+  /// Camera and projector lenses, their relative pose and the code layout: the decoder's
+  /// defaults (Tables 1-2, sections 4.1 and 4.3; see decode/sensor_geometry.hpp). Lens
+  /// distortion is not rendered: set_view() throws if either lens has distortion terms.
+  decode::SensorGeometry geometry = decode::default_sensor_geometry();
+  /// Light levels as fractions of the 8-bit full scale (255 DN), before albedo. Not given
+  /// in the paper (our choice): dim room light, a bright projector (150 lm, Table 1).
+  double ambient_level = 0.10;
+  double projector_level = 0.80;
+  /// If > 0, projector irradiance scales as (falloff_reference_m / distance)^2; 0 = off.
+  double falloff_reference_m = 0.0;
+  /// Gaussian sensor noise per pixel and frame, in DN (our choice; the paper gives none).
+  double noise_sigma_dn = 2.0;
+  std::uint64_t noise_seed = 1;
+  /// Faces seen from behind are not drawn (meshes are closed, counter-clockwise outside).
+  bool cull_back_faces = true;
+  /// A point counts as lit when its projector-frame depth is within this of the projector
+  /// depth buffer (or the buffer holds its own triangle).
+  double shadow_bias_m = 0.002;
+  double near_clip_m = 0.05;
+};
+
+/// One mesh placed in the camera frame (the renderer does not own the mesh).
+struct RenderObject {
+  const geometry::Mesh* mesh = nullptr;
+  Eigen::Isometry3d T_camera_object = Eigen::Isometry3d::Identity();
+  double albedo = 0.7;
+};
+
+/// 8-bit mono image, row-major.
+struct MonoImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> pixels;
+  std::uint8_t at(int x, int y) const { return pixels[static_cast<std::size_t>(y) * width + x]; }
+};
+
+class Renderer {
+ public:
+  explicit Renderer(RendererConfig config);
+
+  const RendererConfig& config() const { return config_; }
+  int width() const { return config_.geometry.camera.width; }
+  int height() const { return config_.geometry.camera.height; }
+
+  /// Geometry pass for one pose of everything (objects in the camera frame).
+  void set_view(const std::vector<RenderObject>& objects);
+
+  /// Frame with bit `bit_index` (0 = MSB) of the pattern, positive or negative, noise drawn
+  /// from (noise_seed, noise_key): the same key gives the same image.
+  void shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out) const;
+
+  /// Motion blur: adds weight x the noise-free intensity (DN) of the current view to `sum`
+  /// (width*height floats); finish() adds noise and quantises.
+  void accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum) const;
+  void finish(const std::vector<float>& sum, std::uint64_t noise_key, MonoImage& out) const;
+
+  // Ground truth of the current view, per camera pixel (row-major):
+  /// Camera-frame z of the visible surface, 0 where nothing is seen.
+  const std::vector<float>& depth_m() const { return depth_m_; }
+  /// Index into set_view()'s objects of the visible surface, -1 where nothing is seen.
+  const std::vector<std::int16_t>& object_index() const { return object_index_; }
+  /// Continuous projector row (pixel centres at integers) of the visible surface point when
+  /// the projector lights it (in its image, not shadowed, facing it); NaN otherwise.
+  const std::vector<float>& projector_row() const { return projector_row_; }
+  /// Code whose rows light the pixel (Eq. 1 layout), -1 when no coded row does.
+  const std::vector<std::int16_t>& code() const { return code_; }
+
+ private:
+  void compute_pixel(int x, int y, const std::vector<RenderObject>& objects);
+
+  RendererConfig config_;
+  PinholeView camera_view_, projector_view_;
+  Eigen::Matrix3f R_projector_camera_;
+  Eigen::Vector3f t_projector_camera_m_, projector_centre_camera_m_;
+  std::vector<float> ray_x_, ray_y_;  ///< normalised camera ray per column / row
+  DepthBuffer camera_buffer_, projector_buffer_;
+  // Per triangle of the current view (ids are cumulative over objects).
+  std::vector<Eigen::Vector3f> normal_camera_;
+  std::vector<std::int16_t> triangle_object_;
+  std::vector<Eigen::Vector3f> scratch_camera_, scratch_projector_;
+  // Per pixel, for shading: intensity = base + gain * bit.
+  std::vector<float> base_dn_, gain_dn_;
+  std::vector<std::uint16_t> gray_;
+  // Ground truth.
+  std::vector<float> depth_m_, projector_row_;
+  std::vector<std::int16_t> object_index_, code_;
+};
+
+/// The noise key of a frame: mixes the frame index so consecutive frames are independent.
+std::uint64_t frame_noise_key(std::uint64_t frame_index);
+
+}  // namespace avs::sim
