@@ -57,6 +57,15 @@ Status OutputFile::write_direct(std::span<const std::byte> bytes) {
   return {};
 }
 
+Status OutputFile::write(std::span<const std::byte> bytes, std::uint32_t crc_of_bytes) {
+  if (crc_enabled_) crc_ = crc32_combine(crc_, crc_of_bytes, bytes.size());
+  const bool enabled = crc_enabled_;
+  crc_enabled_ = false;
+  Status s = write(bytes);
+  crc_enabled_ = enabled;
+  return s;
+}
+
 Status OutputFile::write(std::span<const std::byte> bytes) {
   if (!is_open()) return Status(StatusCode::invalid_argument, "write to a closed file");
   if (crc_enabled_) crc_ = crc32_update(crc_, bytes);

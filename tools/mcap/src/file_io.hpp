@@ -48,6 +48,8 @@ class OutputFile {
   /// Appends; large writes bypass the staging buffer. Updates position() and the CRC.
   Status write(std::span<const std::byte> bytes);
   Status write(const ByteBuffer& bytes) { return write(bytes.span()); }
+  /// As write(), when the caller already has the CRC-32 of `bytes` (saves a pass).
+  Status write(std::span<const std::byte> bytes, std::uint32_t crc_of_bytes);
   Status flush();
   Status close();
   std::uint64_t position() const { return position_; }

@@ -120,7 +120,9 @@ struct Writer::Impl {
     detail::put_chunk_header(scratch, job.start, job.end, job.records.size(), crc, compression,
                              payload.size());
     if (Status s = file.write(scratch); !s.ok()) return s;
-    if (Status s = file.write(payload); !s.ok()) return s;
+    // Uncompressed: the chunk CRC is also the CRC of the payload bytes in the file.
+    const bool known_crc = options.chunk_crc && options.compression == Compression::none;
+    if (Status s = known_crc ? file.write(payload, crc) : file.write(payload); !s.ok()) return s;
 
     ChunkIndex index;
     index.message_start_time = job.start;
