@@ -17,6 +17,7 @@
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/structured_light.hpp>
 
+#include "../src/rolling_kernel.hpp"
 #include "avs/bench/report.hpp"
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/decode/synthetic_plane.hpp"

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
+#include <Eigen/LU>
 
 namespace avs::decode {
 namespace {

@@ -2,6 +2,11 @@
 
 #include <limits>
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define AVS_DECODE_X86 1
+#endif
+
 namespace avs::decode::detail {
 namespace {
 
@@ -11,7 +16,7 @@ template <bool kWithDepth>
 void update_row(const std::uint8_t* __restrict positive, const std::uint8_t* __restrict negative,
                 std::uint16_t* __restrict gray, std::uint16_t* __restrict valid,
                 float* __restrict depth, const float* __restrict ray_x,
-                const float* __restrict ray_y, const PairUpdateArgs& a) {
+                const float* __restrict ray_y, const PairUpdateArgs& a, int begin = 0) {
   const int position = a.bit_position;
   const int psi = a.threshold_psi;
   const auto bit_mask = static_cast<std::uint16_t>(1u << position);
@@ -24,7 +29,7 @@ void update_row(const std::uint8_t* __restrict positive, const std::uint8_t* __r
   const float zmin = a.min_depth_m;
   const float zmax = a.max_depth_m;
   const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (int x = 0; x < a.width; ++x) {
+  for (int x = begin; x < a.width; ++x) {
     // Eq. 2.
     const int difference = static_cast<int>(positive[x]) - static_cast<int>(negative[x]);
     const auto one = static_cast<std::uint16_t>(difference > psi);
@@ -53,9 +58,182 @@ void update_row(const std::uint8_t* __restrict positive, const std::uint8_t* __r
   }
 }
 
+#if defined(AVS_DECODE_X86)
+// The same row update with SSE2 (baseline x86-64), 8 pixels per step. The plane look-up is 4
+// unaligned loads of (a, b, c, 0) and a 4x4 transpose per 4 pixels; the arithmetic order is the
+// scalar one, so results are bit-identical to update_row().
+void update_row_sse2(const std::uint8_t* __restrict positive,
+                     const std::uint8_t* __restrict negative, std::uint16_t* __restrict gray,
+                     std::uint16_t* __restrict valid, float* __restrict depth,
+                     const float* __restrict ray_x, const float* __restrict ray_y,
+                     const PairUpdateArgs& a) {
+  const auto bit_mask = static_cast<std::uint16_t>(1u << a.bit_position);
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i psi = _mm_set1_epi16(static_cast<short>(a.threshold_psi));
+  const __m128i minus_psi = _mm_set1_epi16(static_cast<short>(-a.threshold_psi));
+  const __m128i bit = _mm_set1_epi16(static_cast<short>(bit_mask));
+  const __m128i lower = _mm_set1_epi16(static_cast<short>(bit_mask - 1u));
+  const __m128i forced = _mm_set1_epi16(static_cast<short>(bit_mask >> 1));
+  const __m128i correction = _mm_set1_epi16(a.code_correction ? static_cast<short>(-1) : 0);
+  const __m128i full = _mm_set1_epi16(static_cast<short>(a.full_mask));
+  const __m128i invalid = _mm_set1_epi16(static_cast<short>(a.invalid_index));
+  const __m128 zmin = _mm_set1_ps(a.min_depth_m);
+  const __m128 zmax = _mm_set1_ps(a.max_depth_m);
+  const __m128 one = _mm_set1_ps(1.0f);
+  const __m128 nan = _mm_set1_ps(std::numeric_limits<float>::quiet_NaN());
+  const float* planes = a.planes;
+  int x = 0;
+  for (; x + 8 <= a.width; x += 8) {
+    // Eq. 2.
+    const __m128i p =
+        _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(positive + x)), zero);
+    const __m128i n =
+        _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(negative + x)), zero);
+    const __m128i difference = _mm_sub_epi16(p, n);
+    const __m128i is_one = _mm_cmpgt_epi16(difference, psi);
+    const __m128i known = _mm_or_si128(is_one, _mm_cmplt_epi16(difference, minus_psi));
+    __m128i g = _mm_loadu_si128(reinterpret_cast<const __m128i*>(gray + x));
+    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(valid + x));
+    // Algorithm 1.
+    const __m128i new_bit = _mm_and_si128(is_one, bit);
+    const __m128i same = _mm_cmpeq_epi16(_mm_and_si128(g, bit), new_bit);
+    const __m128i old_known = _mm_cmpeq_epi16(_mm_and_si128(v, bit), bit);
+    const __m128i correct =
+        _mm_and_si128(_mm_andnot_si128(same, _mm_and_si128(old_known, known)), correction);
+    g = _mm_or_si128(_mm_andnot_si128(bit, g), new_bit);
+    g = _mm_or_si128(_mm_andnot_si128(_mm_and_si128(lower, correct), g),
+                     _mm_and_si128(forced, correct));
+    v = _mm_or_si128(_mm_andnot_si128(bit, v), _mm_and_si128(known, bit));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(gray + x), g);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(valid + x), v);
+    // Gray -> binary, invalid pixels to the NaN plane.
+    __m128i b = _mm_xor_si128(g, _mm_srli_epi16(g, 1));
+    b = _mm_xor_si128(b, _mm_srli_epi16(b, 2));
+    b = _mm_xor_si128(b, _mm_srli_epi16(b, 4));
+    b = _mm_xor_si128(b, _mm_srli_epi16(b, 8));
+    const __m128i ok = _mm_cmpeq_epi16(v, full);
+    const __m128i index = _mm_or_si128(_mm_and_si128(ok, b), _mm_andnot_si128(ok, invalid));
+    const int i0 = _mm_extract_epi16(index, 0), i1 = _mm_extract_epi16(index, 1);
+    const int i2 = _mm_extract_epi16(index, 2), i3 = _mm_extract_epi16(index, 3);
+    const int i4 = _mm_extract_epi16(index, 4), i5 = _mm_extract_epi16(index, 5);
+    const int i6 = _mm_extract_epi16(index, 6), i7 = _mm_extract_epi16(index, 7);
+    const int lanes[2][4] = {{i0, i1, i2, i3}, {i4, i5, i6, i7}};
+    for (int half = 0; half < 2; ++half) {
+      __m128 pa = _mm_loadu_ps(planes + 4 * lanes[half][0]);
+      __m128 pb = _mm_loadu_ps(planes + 4 * lanes[half][1]);
+      __m128 pc = _mm_loadu_ps(planes + 4 * lanes[half][2]);
+      __m128 pd = _mm_loadu_ps(planes + 4 * lanes[half][3]);
+      _MM_TRANSPOSE4_PS(pa, pb, pc, pd);  // pa = a, pb = b, pc = c of the 4 pixels
+      const int o = x + 4 * half;
+      const __m128 den = _mm_add_ps(_mm_add_ps(_mm_mul_ps(pa, _mm_loadu_ps(ray_x + o)),
+                                               _mm_mul_ps(pb, _mm_loadu_ps(ray_y + o))),
+                                    pc);
+      const __m128 z = _mm_div_ps(one, den);
+      const __m128 in_range = _mm_and_ps(_mm_cmpgt_ps(z, zmin), _mm_cmplt_ps(z, zmax));
+      _mm_storeu_ps(depth + o, _mm_or_ps(_mm_and_ps(in_range, z), _mm_andnot_ps(in_range, nan)));
+    }
+  }
+  update_row<true>(positive, negative, gray, valid, depth, ray_x, ray_y, a, x);
+}
+
+// AVX2 (chosen at run time): the same 16-bit steps on 8 pixels, the plane look-up by three
+// hardware gathers (faster here than 16 pixels per step).
+__attribute__((target("avx2"))) void update_row_avx2(
+    const std::uint8_t* __restrict positive, const std::uint8_t* __restrict negative,
+    std::uint16_t* __restrict gray, std::uint16_t* __restrict valid, float* __restrict depth,
+    const float* __restrict ray_x, const float* __restrict ray_y, const PairUpdateArgs& a) {
+  const auto bit_mask = static_cast<std::uint16_t>(1u << a.bit_position);
+  const __m128i zero = _mm_setzero_si128();
+  const __m128i psi = _mm_set1_epi16(static_cast<short>(a.threshold_psi));
+  const __m128i minus_psi = _mm_set1_epi16(static_cast<short>(-a.threshold_psi));
+  const __m128i bit = _mm_set1_epi16(static_cast<short>(bit_mask));
+  const __m128i lower = _mm_set1_epi16(static_cast<short>(bit_mask - 1u));
+  const __m128i forced = _mm_set1_epi16(static_cast<short>(bit_mask >> 1));
+  const __m128i correction = _mm_set1_epi16(a.code_correction ? static_cast<short>(-1) : 0);
+  const __m128i full = _mm_set1_epi16(static_cast<short>(a.full_mask));
+  const __m128i invalid = _mm_set1_epi16(static_cast<short>(a.invalid_index));
+  const float* planes = a.planes;
+  int x = 0;
+  for (; x + 8 <= a.width; x += 8) {
+    // Eq. 2.
+    const __m128i p =
+        _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(positive + x)), zero);
+    const __m128i n =
+        _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(negative + x)), zero);
+    const __m128i difference = _mm_sub_epi16(p, n);
+    const __m128i is_one = _mm_cmpgt_epi16(difference, psi);
+    const __m128i known = _mm_or_si128(is_one, _mm_cmplt_epi16(difference, minus_psi));
+    __m128i g = _mm_loadu_si128(reinterpret_cast<const __m128i*>(gray + x));
+    __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(valid + x));
+    // Algorithm 1.
+    const __m128i new_bit = _mm_and_si128(is_one, bit);
+    const __m128i same = _mm_cmpeq_epi16(_mm_and_si128(g, bit), new_bit);
+    const __m128i old_known = _mm_cmpeq_epi16(_mm_and_si128(v, bit), bit);
+    const __m128i correct =
+        _mm_and_si128(_mm_andnot_si128(same, _mm_and_si128(old_known, known)), correction);
+    g = _mm_or_si128(_mm_andnot_si128(bit, g), new_bit);
+    g = _mm_or_si128(_mm_andnot_si128(_mm_and_si128(lower, correct), g),
+                     _mm_and_si128(forced, correct));
+    v = _mm_or_si128(_mm_andnot_si128(bit, v), _mm_and_si128(known, bit));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(gray + x), g);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(valid + x), v);
+    // Gray -> binary, invalid pixels to the NaN plane.
+    __m128i b = _mm_xor_si128(g, _mm_srli_epi16(g, 1));
+    b = _mm_xor_si128(b, _mm_srli_epi16(b, 2));
+    b = _mm_xor_si128(b, _mm_srli_epi16(b, 4));
+    b = _mm_xor_si128(b, _mm_srli_epi16(b, 8));
+    const __m128i ok = _mm_cmpeq_epi16(v, full);
+    const __m128i index = _mm_or_si128(_mm_and_si128(ok, b), _mm_andnot_si128(ok, invalid));
+    const __m256i offsets = _mm256_slli_epi32(_mm256_cvtepu16_epi32(index), 2);
+    const __m256 pa = _mm256_i32gather_ps(planes, offsets, 4);
+    const __m256 pb = _mm256_i32gather_ps(planes + 1, offsets, 4);
+    const __m256 pc = _mm256_i32gather_ps(planes + 2, offsets, 4);
+    const __m256 den = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(pa, _mm256_loadu_ps(ray_x + x)),
+                                                   _mm256_mul_ps(pb, _mm256_loadu_ps(ray_y + x))),
+                                     pc);
+    const __m256 z = _mm256_div_ps(_mm256_set1_ps(1.0f), den);
+    const __m256 in_range =
+        _mm256_and_ps(_mm256_cmp_ps(z, _mm256_set1_ps(a.min_depth_m), _CMP_GT_OQ),
+                      _mm256_cmp_ps(z, _mm256_set1_ps(a.max_depth_m), _CMP_LT_OQ));
+    _mm256_storeu_ps(
+        depth + x,
+        _mm256_blendv_ps(_mm256_set1_ps(std::numeric_limits<float>::quiet_NaN()), z, in_range));
+  }
+  update_row<true>(positive, negative, gray, valid, depth, ray_x, ray_y, a, x);
+}
+#endif
+
 }  // namespace
 
+KernelIsa best_kernel_isa() {
+#if defined(AVS_DECODE_X86)
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  return has_avx2 ? KernelIsa::kAvx2 : KernelIsa::kSse2;
+#else
+  return KernelIsa::kScalar;
+#endif
+}
+
+const char* kernel_isa_name(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::kScalar:
+      return "scalar";
+    case KernelIsa::kSse2:
+      return "sse2";
+    case KernelIsa::kAvx2:
+      return "avx2";
+  }
+  return "?";
+}
+
 void update_pair(const PairUpdateArgs& a) {
+  update_pair(a, best_kernel_isa());
+}
+
+void update_pair(const PairUpdateArgs& a, KernelIsa isa) {
+#if !defined(AVS_DECODE_X86)
+  isa = KernelIsa::kScalar;
+#endif
   for (int y = 0; y < a.height; ++y) {
     const std::ptrdiff_t row = static_cast<std::ptrdiff_t>(y) * a.width;
     const auto* positive = a.positive + y * a.positive_stride;
@@ -63,9 +241,23 @@ void update_pair(const PairUpdateArgs& a) {
     if (a.depth_m == nullptr) {
       update_row<false>(positive, negative, a.gray + row, a.valid + row, nullptr, nullptr, nullptr,
                         a);
-    } else {
-      update_row<true>(positive, negative, a.gray + row, a.valid + row, a.depth_m + row,
-                       a.ray_x + row, a.ray_y + row, a);
+      continue;
+    }
+    float* depth = a.depth_m + row;
+    switch (isa) {
+#if defined(AVS_DECODE_X86)
+      case KernelIsa::kAvx2:
+        update_row_avx2(positive, negative, a.gray + row, a.valid + row, depth, a.ray_x + row,
+                        a.ray_y + row, a);
+        break;
+      case KernelIsa::kSse2:
+        update_row_sse2(positive, negative, a.gray + row, a.valid + row, depth, a.ray_x + row,
+                        a.ray_y + row, a);
+        break;
+#endif
+      default:
+        update_row<true>(positive, negative, a.gray + row, a.valid + row, depth, a.ray_x + row,
+                         a.ray_y + row, a);
     }
   }
 }

@@ -29,8 +29,16 @@ struct PairUpdateArgs {
   float max_depth_m = 0;
 };
 
+enum class KernelIsa { kScalar, kSse2, kAvx2 };
+
+/// AVX2 when the CPU has it (checked once at run time), else SSE2 (baseline x86-64), else scalar.
+KernelIsa best_kernel_isa();
+const char* kernel_isa_name(KernelIsa isa);
+
 /// Eq. 2 binarisation of one pair, bit k written into every pixel's Gray word (with Algorithm 1
 /// when enabled), Gray -> binary, and depth = 1 / (a x + b y + c) from the tables.
 void update_pair(const PairUpdateArgs& args);
+/// Same with a given instruction set (all give bit-identical results).
+void update_pair(const PairUpdateArgs& args, KernelIsa isa);
 
 }  // namespace avs::decode::detail
