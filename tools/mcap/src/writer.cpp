@@ -216,7 +216,13 @@ Writer::~Writer() {
   if (is_open()) (void)close();
 }
 Writer::Writer(Writer&&) noexcept = default;
-Writer& Writer::operator=(Writer&&) noexcept = default;
+Writer& Writer::operator=(Writer&& other) noexcept {
+  if (this != &other) {
+    if (is_open()) (void)close();  // an open file is finished, not abandoned
+    impl_ = std::move(other.impl_);
+  }
+  return *this;
+}
 
 bool Writer::is_open() const {
   return impl_ != nullptr && impl_->file.is_open();
