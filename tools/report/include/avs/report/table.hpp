@@ -1,0 +1,31 @@
+// Plain-text tables for the terminal (`avs demo`, `avs experiments`, `avs report`).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "avs/report/paper.hpp"
+
+namespace avs::report {
+
+/// Columns padded to their widest cell; numeric-looking cells are right-aligned.
+class TextTable {
+ public:
+  explicit TextTable(std::vector<std::string> headers) : headers_(std::move(headers)) {}
+  /// Throws ReportError when the row's cell count differs from the header's.
+  void add_row(std::vector<std::string> cells);
+  [[nodiscard]] std::string render() const;
+
+ private:
+  std::vector<std::string> headers_;
+  std::vector<std::vector<std::string>> rows_;
+};
+
+/// A figure for a table: "-" for NaN, integers without decimals, else 4 significant digits.
+[[nodiscard]] std::string format_figure(double value);
+
+/// The results table of a run: figure | paper | ours | unit | section.
+[[nodiscard]] std::string format_comparison_table(const std::string& scenario,
+                                                  const Summary& summary);
+
+}  // namespace avs::report

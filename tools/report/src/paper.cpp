@@ -1,0 +1,115 @@
+#include "avs/report/paper.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace avs::report {
+
+const std::vector<PaperFigure>& paper_figures() {
+  // Quoted from Sec. 7 (and Sec. 2, 8) of the paper; the GPU is an NVIDIA GTX 1080 Ti (Sec. 2).
+  static const std::vector<PaperFigure> figures{
+      {"tracking", "depth_rate_hz", "depth update rate", "500", "Hz", "3.1, 7.1",
+       "Sec. 3.1: 'the update frame rate is 500 Hz'"},
+      {"tracking", "decode_ms_median", "depth computation per update (GPU)", "about 1.5", "ms",
+       "7.1.1", "'The time taken to calculate the depth value was about 1.5 ms'"},
+      {"tracking", "decode_ms_p99", "depth computation within the pattern pair time", "< 2", "ms",
+       "7.1.1", "'shorter than the 2 ms taken to project 1-bit positive and negative patterns'"},
+      {"tracking", "in_view_fraction", "target kept in the field of view", "kept in view", "",
+       "7.1.1", "Fig. 8: 'could keep the target object within the field of view'"},
+      {"tracking", "centroid_error_px_rms", "centroid error in the image", "Fig. 8 (no number)",
+       "px", "7.1.1", "Fig. 8: temporal response of error in image plane"},
+      {"no_tracking", "depth_rate_hz", "depth update rate", "500", "Hz", "7.1.2",
+       "same sensor as 7.1.1"},
+      {"no_tracking", "in_view_fraction", "target in the field of view",
+       "grip lost in large swings", "", "7.1.2",
+       "Fig. 11: 'the grip of the ken disappeared when it was swung largely'"},
+      {"ken", "pose_rate_hz", "pose rate (model matching)", "500", "Hz", "7.2.1",
+       "'the measurement could be achieved at a frame rate of 500 fps'"},
+      {"ken", "matching_ms_median", "matching time per update", "about 1", "ms", "7.2.1",
+       "Fig. 13b: 'the processing time was about 1 ms'"},
+      {"ken", "matching_ms_max", "matching time per update, max", "< 1.5", "ms", "7.2.1",
+       "Fig. 13b: 'and less than 1.5 ms'"},
+      {"ken", "init_ms", "initial alignment", "148", "ms", "7.2.1",
+       "'The time required for the initial alignment was 148 ms'"},
+      {"ken", "scene_points_min", "S-PCD points, min", "about 50", "", "7.2.1",
+       "Fig. 13a: 'kept between 50 and 200 points'"},
+      {"ken", "scene_points_max", "S-PCD points, max", "about 200", "", "7.2.1",
+       "Fig. 13a: 'kept between 50 and 200 points'"},
+      {"ken", "flips", "180-degree reversals about Y", "sometimes", "frames", "7.2.1",
+       "'it was reversed 180 degrees around the Y-axis sometimes'"},
+      {"ken", "position_error_mm_rms", "position error", "Fig. 15 (no number)", "mm", "7.2.1",
+       "'there were no large errors in these measurements'"},
+      {"ken", "orientation_error_deg_rms", "orientation error", "Fig. 16 (no number)", "deg",
+       "7.2.1", "'there were no large errors in these measurements'"},
+      {"cube", "init_ms", "initial alignment", "93.98", "ms", "7.2.2",
+       "'The time required for the initial alignment was 93.98 ms'"},
+      {"cube", "pose_rate_hz", "ICP rate", "487", "Hz", "7.2.2",
+       "'The frequency of the ICP was 487 fps'"},
+      {"cylinder", "pose_rate_hz", "ICP rate", "495", "Hz", "7.2.3",
+       "'The frequency of the ICP was 495 fps'"},
+      {"init", "init_ms", "initial alignment (ken)", "148", "ms", "7.2.1, 7.4",
+       "'The time required for the initial alignment was 148 ms'"},
+      {"init", "init_ms", "initial alignment (cube)", "93.98", "ms", "7.2.2, 7.4",
+       "'The time required for the initial alignment was 93.98 ms'"},
+      {"correction", "depth_rate_hz", "depth update rate", "500", "Hz", "7.3",
+       "Fig. 21: correction shown as pictures only"},
+  };
+  return figures;
+}
+
+const std::vector<std::string>& known_scenarios() {
+  static const std::vector<std::string> scenarios{"demo", "tracking", "no_tracking", "ken",
+                                                  "cube", "cylinder", "correction",  "init"};
+  return scenarios;
+}
+
+std::vector<ComparisonRow> comparison_rows(const std::string& scenario, const Summary& summary) {
+  // "demo" is the ken on the manipulator with tracking and matching on.
+  const std::vector<std::string> sources = scenario == "demo"
+                                               ? std::vector<std::string>{"tracking", "ken"}
+                                               : std::vector<std::string>{scenario};
+  std::vector<ComparisonRow> rows;
+  for (const std::string& source : sources) {
+    for (const PaperFigure& figure : paper_figures()) {
+      if (source != figure.scenario) continue;
+      rows.push_back({figure.label, figure.unit, figure.paper, summary_value(summary, figure.key),
+                      figure.section, figure.key});
+    }
+  }
+  // Our main figures that the paper gives no number for, when the run has data for them.
+  static const std::vector<std::pair<const char*, const char*>> ours_only{
+      {"depth_rate_hz", "Hz"},
+      {"pose_rate_hz", "Hz"},
+      {"decode_ms_median", "ms"},
+      {"decode_ms_p99", "ms"},
+      {"tracking_ms_median", "ms"},
+      {"tracking_ms_p99", "ms"},
+      {"matching_ms_median", "ms"},
+      {"matching_ms_p99", "ms"},
+      {"init_ms", "ms"},
+      {"position_error_mm_rms", "mm"},
+      {"position_error_mm_p99", "mm"},
+      {"orientation_error_deg_rms", "deg"},
+      {"orientation_error_deg_rms_excluding_flips", "deg"},
+      {"flips", "frames"},
+      {"in_view_fraction", ""},
+      {"centroid_error_px_rms", "px"},
+      {"scene_points_median", ""},
+  };
+  for (const auto& [key, unit] : ours_only) {
+    const double value = summary_value(summary, key);
+    if (std::isnan(value)) continue;
+    if (std::any_of(rows.begin(), rows.end(), [&](const auto& r) { return r.key == key; })) {
+      continue;
+    }
+    if (std::string(key) == "flips" && std::isnan(summary.position_error_mm_rms)) continue;
+    std::string label;
+    for (const SummaryField& field : summary_fields()) {
+      if (field.key == std::string(key)) label = field.description;
+    }
+    rows.push_back({label, unit, "-", value, "-", key});
+  }
+  return rows;
+}
+
+}  // namespace avs::report

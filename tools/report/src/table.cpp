@@ -1,0 +1,82 @@
+#include "avs/report/table.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace avs::report {
+namespace {
+
+bool looks_numeric(const std::string& cell) {
+  if (cell.empty() || cell == "-") return !cell.empty();
+  return std::all_of(cell.begin(), cell.end(), [](char c) {
+    return (c >= '0' && c <= '9') || c == '.' || c == '-' || c == '+' || c == 'e';
+  });
+}
+
+/// Display width of UTF-8 text (counts code points, not bytes).
+std::size_t display_width(const std::string& text) {
+  return static_cast<std::size_t>(std::count_if(text.begin(), text.end(), [](char c) {
+    return (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  }));
+}
+
+}  // namespace
+
+void TextTable::add_row(std::vector<std::string> cells) {
+  if (cells.size() != headers_.size()) {
+    throw ReportError("TextTable: row of " + std::to_string(cells.size()) + " cells, header has " +
+                      std::to_string(headers_.size()));
+  }
+  rows_.push_back(std::move(cells));
+}
+
+std::string TextTable::render() const {
+  std::vector<std::size_t> widths(headers_.size());
+  for (std::size_t c = 0; c < headers_.size(); ++c) {
+    widths[c] = display_width(headers_[c]);
+    for (const auto& row : rows_) widths[c] = std::max(widths[c], display_width(row[c]));
+  }
+  std::string out;
+  const auto emit = [&](const std::vector<std::string>& cells, bool header) {
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const std::size_t pad = widths[c] - display_width(cells[c]);
+      const bool right = !header && looks_numeric(cells[c]);
+      if (c > 0) out += "  ";
+      if (right) out.append(pad, ' ');
+      out += cells[c];
+      if (!right && c + 1 < cells.size()) out.append(pad, ' ');
+    }
+    out += '\n';
+  };
+  emit(headers_, true);
+  std::size_t total = 0;
+  for (std::size_t w : widths) total += w;
+  out.append(total + 2 * (widths.size() - 1), '-');
+  out += '\n';
+  for (const auto& row : rows_) emit(row, false);
+  return out;
+}
+
+std::string format_figure(double value) {
+  if (!std::isfinite(value)) return "-";
+  char buffer[64];
+  if (value == std::round(value) && std::abs(value) < 1e15) {
+    std::snprintf(buffer, sizeof(buffer), "%.0f", value);
+  } else if (std::abs(value) >= 1000.0) {
+    std::snprintf(buffer, sizeof(buffer), "%.0f", value);
+  } else {
+    std::snprintf(buffer, sizeof(buffer), "%.4g", value);
+  }
+  return buffer;
+}
+
+std::string format_comparison_table(const std::string& scenario, const Summary& summary) {
+  TextTable table({"figure", "paper", "ours", "unit", "section"});
+  for (const ComparisonRow& row : comparison_rows(scenario, summary)) {
+    table.add_row({row.label, row.paper, format_figure(row.ours), row.unit, row.section});
+  }
+  return table.render();
+}
+
+}  // namespace avs::report
