@@ -2,6 +2,7 @@
 // The expected values come from decode::SensorGeometry's own projection and ray functions
 // and analytic intersections, not from the renderer's code paths.
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <optional>
@@ -92,11 +93,15 @@ TEST(Renderer, PlaneBitsMatchProjectorPatternAtTrueSurfacePoint) {
   }
   ASSERT_GT(lit_pixels, renderer.width() * renderer.height() / 2);
   const double fraction = double(agree) / double(checks);
+  std::printf("bit agreement %.5f over %ld lit pixels\n", fraction, lit_pixels);
   EXPECT_GE(fraction, 0.995) << agree << " of " << checks << " bits agree";
 }
 
-TEST(Renderer, ShadowedPixelsShowNoPattern) {
+class ShadowTest : public ::testing::TestWithParam<double> {};
+
+TEST_P(ShadowTest, ShadowedPixelsShowNoPattern) {
   RendererConfig config;
+  config.shadow_map_scale = GetParam();
   Renderer renderer(config);
   const decode::SensorGeometry& g = config.geometry;
   const geometry::Mesh plane = geometry::make_plane(4.0, 4.0, 1);
@@ -142,6 +147,8 @@ TEST(Renderer, ShadowedPixelsShowNoPattern) {
   EXPECT_EQ(quiet, shadowed) << "shadowed pixels with a pattern";
   EXPECT_GE(patterned, lit * 999 / 1000) << "lit pixels without a pattern";
 }
+
+INSTANTIATE_TEST_SUITE_P(ShadowMapScales, ShadowTest, ::testing::Values(0.5, 1.0));
 
 TEST(Renderer, IntensityFollowsAlbedoAmbientAndShading) {
   RendererConfig config;

@@ -32,6 +32,8 @@ struct RendererConfig {
   /// If > 0, projector irradiance scales as (falloff_reference_m / distance)^2; 0 = off.
   double falloff_reference_m = 0.0;
   /// Gaussian sensor noise per pixel and frame, in DN (our choice; the paper gives none).
+  /// Samples come from a bank of 2^20 N(0, 1) values drawn once from noise_seed (quantised
+  /// to 1/32 sigma, clipped at +-3.97 sigma), read at an offset chosen by each frame's key.
   double noise_sigma_dn = 2.0;
   std::uint64_t noise_seed = 1;
   /// Faces seen from behind are not drawn (meshes are closed, counter-clockwise outside).
@@ -39,6 +41,9 @@ struct RendererConfig {
   /// A point counts as lit when its projector-frame depth is within this of the projector
   /// depth buffer (or the buffer holds its own triangle).
   double shadow_bias_m = 0.002;
+  /// Resolution of the projector depth buffer used for the shadow test, relative to the
+  /// DMD (our choice for speed: 0.5 gives 2 x 2 DMD pixels per cell, about 1.6 mm at 1 m).
+  double shadow_map_scale = 0.5;
   double near_clip_m = 0.05;
 };
 
@@ -83,16 +88,22 @@ class Renderer {
   /// Index into set_view()'s objects of the visible surface, -1 where nothing is seen.
   const std::vector<std::int16_t>& object_index() const { return object_index_; }
   /// Continuous projector row (pixel centres at integers) of the visible surface point when
-  /// the projector lights it (in its image, not shadowed, facing it); NaN otherwise.
+  /// the projector lights it (inside its coded rows, not shadowed, facing it); NaN otherwise.
   const std::vector<float>& projector_row() const { return projector_row_; }
   /// Code whose rows light the pixel (Eq. 1 layout), -1 when no coded row does.
   const std::vector<std::int16_t>& code() const { return code_; }
 
  private:
-  void compute_pixel(int x, int y, const std::vector<RenderObject>& objects);
+  void prepare_triangles(const std::vector<RenderObject>& objects);
+  void compute_row(int y);
+  template <typename ValueFn>
+  void quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) const;
 
   RendererConfig config_;
-  PinholeView camera_view_, projector_view_;
+  PinholeView camera_view_, shadow_view_;
+  decode::LensModel projector_;
+  std::vector<std::int16_t> row_code_;   ///< code of each projector row, -1 if uncoded
+  std::vector<std::int8_t> noise_bank_;  ///< N(0, 1) samples x 32, drawn once from noise_seed
   Eigen::Matrix3f R_projector_camera_;
   Eigen::Vector3f t_projector_camera_m_, projector_centre_camera_m_;
   std::vector<float> ray_x_, ray_y_;  ///< normalised camera ray per column / row
@@ -100,6 +111,7 @@ class Renderer {
   // Per triangle of the current view (ids are cumulative over objects).
   std::vector<Eigen::Vector3f> normal_camera_;
   std::vector<std::int16_t> triangle_object_;
+  std::vector<float> triangle_albedo_dn_;  ///< 255 x albedo of the triangle's object
   std::vector<Eigen::Vector3f> scratch_camera_, scratch_projector_;
   // Per pixel, for shading: intensity = base + gain * bit.
   std::vector<float> base_dn_, gain_dn_;
