@@ -57,7 +57,8 @@ DriveClient::DriveClient(DriveClientConfig config) : config_(std::move(config)),
   if (!(config_.cycle_rate_hz > 0)) throw ConfigError("servo_drive: cycle_rate_hz must be > 0");
   const double period_s = 1.0 / config_.cycle_rate_hz;
   if (!(config_.response_timeout_s > 0) ||
-      config_.response_timeout_s * config_.axes.size() >= period_s) {
+      (config_.require_timeout_within_period &&
+       config_.response_timeout_s * static_cast<double>(config_.axes.size()) >= period_s)) {
     char msg[256];
     std::snprintf(msg, sizeof msg,
                   "servo_drive: response_timeout_s %.6f x %zu axes does not fit in the %.6f s "
@@ -520,6 +521,7 @@ CycleResult DriveClient::cycle(double now_s) {
       return result;
     }
     fb.commanded_torque_nm = safe.torque_nm;
+    fb.controlword = cw;
     fb.safety_reasons = safe.reasons;
     rt.last = fb;
     result.axes[i] = fb;

@@ -55,9 +55,13 @@ struct DriveClientConfig {
   RtuLinkConfig rtu;
   std::vector<DriveAxisConfig> axes;
   double cycle_rate_hz = 1000.0;
-  double response_timeout_s = 0.0005;  ///< must be below the period
-  double command_timeout_s = 0.02;     ///< older commands -> zero torque
-  bool use_write_read_0x17 = true;     ///< else 0x10 write(s) + 0x03 read
+  double response_timeout_s = 0.0005;  ///< must be below the period (see below)
+  /// Refuse response_timeout_s x axes >= period (real time). Off only in lockstep simulation,
+  /// where the wait costs wall time but no simulated time, and a generous wall timeout keeps a
+  /// loaded machine from turning a slow reply into a (non-deterministic) link fault.
+  bool require_timeout_within_period = true;
+  double command_timeout_s = 0.02;  ///< older commands -> zero torque
+  bool use_write_read_0x17 = true;  ///< else 0x10 write(s) + 0x03 read
   double reconnect_backoff_initial_s = 0.005;
   double reconnect_backoff_max_s = 0.5;
   EstopAction estop_action = EstopAction::disable_operation;
@@ -76,6 +80,7 @@ struct AxisFeedback {
   DriveState state = DriveState::not_ready_to_switch_on;
   std::uint16_t error_code = 0;
   double commanded_torque_nm = 0;  ///< what this cycle wrote (0 when not written)
+  std::uint16_t controlword = 0;   ///< what this cycle wrote
   std::uint32_t safety_reasons = safety_none;
 };
 
@@ -131,6 +136,9 @@ class DriveClient {
   LinkStatistics statistics() const;
   const DriveClientConfig& config() const { return config_; }
   bool connected() const { return ctx_ != nullptr; }
+  /// Non-empty once a reconnect found a configuration mismatch (e.g. word order): the client
+  /// stops retrying and every cycle reports this.
+  const std::string& fatal_error() const { return fatal_error_; }
 
  private:
   struct WriteRun {

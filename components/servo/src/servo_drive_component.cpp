@@ -1,0 +1,531 @@
+// servo_drive: the only component that talks to the servo amplifiers (issue 5 item 3). Wraps
+// DriveClient (Modbus TCP/RTU, CiA 402, safety rules): enable on activate, disable on
+// deactivate, one cyclic exchange per period, either
+//   * as a container timer (own_thread: false): REQUIRED in sim time, so that a lockstep run
+//     is deterministic (the exchange happens at exact simulated instants, in timer order), or
+//   * on its own thread (own_thread: true, wall time / real hardware), with an absolute
+//     schedule on the steady clock and optional SCHED_FIFO priority.
+// Publishes /head/joint_states every good cycle and /head/drive_status at status_rate_hz (and
+// at once when the link or fault state changes); takes /head/torque_command and /head/estop.
+#include <pthread.h>
+#include <sched.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include <yaml-cpp/yaml.h>
+
+#include "avs/runtime/component.hpp"
+#include "avs/servo/drive_client.hpp"
+#include "avs/servo/plant.hpp"
+#include "avs/servo/register_map_yaml.hpp"
+
+namespace avs::servo {
+
+using runtime::ComponentContext;
+using runtime::ComponentSpec;
+using runtime::ParamSpec;
+
+namespace {
+
+std::vector<std::string> split_names(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    item.erase(0, item.find_first_not_of(" \t"));
+    item.erase(item.find_last_not_of(" \t") + 1);
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+double element(const std::vector<double>& list, std::size_t i, const std::string& param) {
+  if (i >= list.size()) {
+    throw ConfigError("servo_drive: parameter '" + param + "' has " + std::to_string(list.size()) +
+                      " values, expected one per axis (" + std::to_string(i + 1) + " or more)");
+  }
+  return list[i];
+}
+
+/// The register map(s) of `register_map` (docs/servo.md): a file with one map for every axis,
+/// or `axes: {<name>: <map>, ...}` with one map per axis name.
+std::vector<RegisterMap> load_maps(const std::string& path, const std::vector<std::string>& names) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path + ": cannot open register map");
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  std::vector<RegisterMap> maps;
+  if (root.IsMap() && root["axes"]) {
+    const YAML::Node axes = root["axes"];
+    for (const std::string& name : names) {
+      if (!axes[name]) {
+        throw ConfigError(path + ":" + std::to_string(axes.Mark().line + 1) +
+                          ": axes: no map for axis '" + name + "'");
+      }
+      maps.push_back(parse_register_map(axes[name], path));
+    }
+  } else {
+    const RegisterMap map = parse_register_map(root, path);
+    maps.assign(names.size(), map);
+  }
+  return maps;
+}
+
+}  // namespace
+
+class ServoDrive final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    using runtime::QosProfile;
+    QosProfile keep_last_1;
+    keep_last_1.depth = 1;
+    QosProfile estop_qos;
+    estop_qos.depth = 1;
+    estop_qos.durability = runtime::Durability::transient_local;
+    return {
+        .type = "servo_drive",
+        .description =
+            "servo amplifiers over Modbus TCP/RTU (CiA 402, torque mode) with the "
+            "host-side safety rules; publishes joint states and drive status",
+        .parameters =
+            {ParamSpec::string("transport", "tcp", "Modbus transport", {"tcp", "rtu"}),
+             ParamSpec::string("host", "127.0.0.1", "TCP: amplifier address"),
+             ParamSpec::integer("port", 1502, 1, 65535, "", "TCP: amplifier port"),
+             ParamSpec::string("axis_names", "pan,tilt", "comma-separated joint names, in order"),
+             ParamSpec::real_list("unit_ids", {1, 2}, "", "Modbus unit id per axis"),
+             ParamSpec::string("rtu_device", "/dev/ttyUSB0", "RTU: serial device"),
+             ParamSpec::integer("rtu_baud", 115200, 1200, 12000000, "Bd", "RTU: baud rate"),
+             ParamSpec::string("rtu_parity", "E", "RTU: parity", {"N", "E", "O"}),
+             ParamSpec::integer("rtu_data_bits", 8, 7, 8, "", "RTU: data bits"),
+             ParamSpec::integer("rtu_stop_bits", 1, 1, 2, "", "RTU: stop bits"),
+             ParamSpec::boolean("rtu_rs485", true, "RTU: RS-485 serial mode"),
+             ParamSpec::string("rtu_rts", "none", "RTU: RTS direction control",
+                               {"none", "up", "down"}),
+             ParamSpec::integer("rtu_rts_delay_us", -1, -1, 1000000, "us",
+                                "RTU: RTS delay (-1 = libmodbus default)"),
+             ParamSpec::real("rtu_turnaround_s", 0.0005, 0.0, 1.0, "s",
+                             "RTU: drive reply delay, used by the link budget check"),
+             ParamSpec::string("register_map", "",
+                               "register map YAML file (docs/servo.md); empty = the simulated "
+                               "amplifier's map for pan/tilt"),
+             ParamSpec::real("cycle_rate_hz", 1000.0, 1.0, 10000.0, "Hz", "cyclic exchange rate"),
+             ParamSpec::real("response_timeout_s", 0.0, 0.0, 10.0, "s",
+                             "Modbus response timeout (wall time); 0 = auto: 0.4 x period / axes "
+                             "in wall time, 1 s in sim time (waiting costs no simulated time)"),
+             ParamSpec::boolean("use_write_read_0x17", true,
+                                "one 0x17 write+read per axis, else 0x10 + 0x03"),
+             ParamSpec::real("command_timeout_s", 0.02, 0.0001, 10.0, "s",
+                             "torque commands older than this -> zero torque"),
+             ParamSpec::real_list("max_torque_nm", {5.73, 0.9555}, "N m",
+                                  "configured motor torque limit per axis (also written to the "
+                                  "drive's max_torque)"),
+             ParamSpec::real_list("motor_max_torque_nm", {5.73, 0.9555}, "N m",
+                                  "motor peak torque per axis (Table 3)"),
+             ParamSpec::real_list("soft_lower_rad", {-3.0, -1.4}, "rad",
+                                  "soft lower position limit per axis"),
+             ParamSpec::real_list("soft_upper_rad", {3.0, 1.4}, "rad",
+                                  "soft upper position limit per axis"),
+             ParamSpec::real("brake_zone_rad", 0.1, 0.0, 10.0, "rad",
+                             "braking zone inside each soft limit"),
+             ParamSpec::real_list("brake_gain_nm_s_per_rad", {0.05, 0.01}, "N m s/rad",
+                                  "braking torque per output rad/s toward a nearby limit"),
+             ParamSpec::string("estop_action", "disable_operation", "what an e-stop does",
+                               {"disable_operation", "quick_stop"}),
+             ParamSpec::boolean("auto_fault_reset", false,
+                                "reset drive faults automatically once their cause is gone"),
+             ParamSpec::real("reconnect_backoff_initial_s", 0.005, 0.0001, 60.0, "s",
+                             "first reconnect delay after a link fault (doubles)"),
+             ParamSpec::real("reconnect_backoff_max_s", 0.5, 0.0001, 600.0, "s",
+                             "reconnect delay bound"),
+             ParamSpec::boolean("own_thread", false,
+                                "cycle on a thread of its own (wall time only); false = "
+                                "container timer (required in sim time)"),
+             ParamSpec::integer("rt_priority", 0, 0, 99, "",
+                                "own_thread: SCHED_FIFO priority (0 = normal scheduling)"),
+             ParamSpec::real("status_rate_hz", 10.0, 0.1, 1000.0, "Hz", "/head/drive_status rate"),
+             ParamSpec::string("report_dir", "",
+                               "tests: write <name>.csv (every cycle) and <name>.yaml (summary) "
+                               "here on deactivate; empty = none")},
+        .publishes = {runtime::port<msgs::sensor_msgs::JointState>("joint_states",
+                                                                   "/head/joint_states"),
+                      runtime::port<msgs::avs_msgs::DriveStatus>(
+                          "drive_status", "/head/drive_status", keep_last_1)},
+        .subscribes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
+                           "torque_command", "/head/torque_command", keep_last_1),
+                       runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos)}};
+  }
+
+  explicit ServoDrive(ComponentContext& ctx)
+      : Component(ctx),
+        joint_states_(ctx.publisher<msgs::sensor_msgs::JointState>("joint_states")),
+        drive_status_(ctx.publisher<msgs::avs_msgs::DriveStatus>("drive_status")),
+        own_thread_(ctx.param<bool>("own_thread")),
+        rt_priority_(ctx.param<int>("rt_priority")),
+        report_dir_(ctx.param<std::string>("report_dir")) {
+    if (own_thread_ && ctx.uses_sim_time()) {
+      throw ConfigError(
+          "servo_drive: own_thread: true needs wall time; in sim time the cycle must run as a "
+          "container timer (own_thread: false) to stay deterministic");
+    }
+    DriveClientConfig config = make_config(ctx);
+    const double status_rate = ctx.param<double>("status_rate_hz");
+    cycles_per_status_ =
+        std::max<std::int64_t>(1, std::llround(config.cycle_rate_hz / status_rate));
+    period_ = runtime::Duration(std::llround(1e9 / config.cycle_rate_hz));
+    for (const DriveAxisConfig& axis : config.axes) names_.push_back(axis.name);
+    client_ = std::make_unique<DriveClient>(std::move(config));  // validates: one-line ConfigError
+    try {
+      client_->connect();  // configure: word-order probe, mode, drive torque limit
+      log().info("connected: ", describe_link());
+    } catch (const ConfigError&) {
+      throw;  // wrong register map / word order: refuse to load
+    } catch (const std::exception& e) {
+      log().warn(e.what(), "; retrying from the cyclic exchange with back-off");
+    }
+
+    ctx.subscribe<msgs::avs_msgs::JointTorqueCommand>(
+        "torque_command",
+        [this](runtime::SamplePtr<msgs::avs_msgs::JointTorqueCommand> m) { on_command(*m); });
+    ctx.subscribe<msgs::std_msgs::Bool>(
+        "estop", [this](runtime::SamplePtr<msgs::std_msgs::Bool> m) { on_estop(m->data); });
+  }
+
+  ~ServoDrive() override { stop_thread(); }
+
+  void on_activate() override {
+    client_->activate(context().now().seconds());
+    if (own_thread_) {
+      stop_ = false;
+      thread_ = std::thread([this] { thread_loop(); });
+    } else {
+      timer_ = context().create_timer(period_, [this] { run_cycle(); });
+    }
+  }
+
+  void on_deactivate() override {
+    stop_thread();
+    if (timer_ != 0) context().cancel_timer(timer_);
+    timer_ = 0;
+    client_->deactivate();
+    try {
+      client_->cycle(context().now().seconds());  // writes torque 0 and Disable operation
+    } catch (const std::exception& e) {
+      log().warn("deactivate: ", e.what());
+    }
+    const LinkStatistics s = client_->statistics();
+    log().info(cycles_, " cycles, ", s.exchanges, " exchanges, ", link_fault_cycles_,
+               " with a link fault, ", s.timeouts, " timeouts, ", s.reconnects, " reconnects");
+    write_report(s);
+  }
+
+  void on_shutdown() override { client_->disconnect(); }
+
+ private:
+  DriveClientConfig make_config(ComponentContext& ctx) {
+    DriveClientConfig c;
+    c.transport = ctx.param<std::string>("transport") == "rtu" ? Transport::rtu : Transport::tcp;
+    c.tcp.host = ctx.param<std::string>("host");
+    c.tcp.port = ctx.param<int>("port");
+    c.rtu.device = ctx.param<std::string>("rtu_device");
+    c.rtu.line.baud = ctx.param<int>("rtu_baud");
+    c.rtu.line.parity = ctx.param<std::string>("rtu_parity")[0];
+    c.rtu.line.data_bits = ctx.param<int>("rtu_data_bits");
+    c.rtu.line.stop_bits = ctx.param<int>("rtu_stop_bits");
+    c.rtu.rs485 = ctx.param<bool>("rtu_rs485");
+    const std::string rts = ctx.param<std::string>("rtu_rts");
+    c.rtu.rts = rts == "up"     ? MODBUS_RTU_RTS_UP
+                : rts == "down" ? MODBUS_RTU_RTS_DOWN
+                                : MODBUS_RTU_RTS_NONE;
+    c.rtu.rts_delay_us = ctx.param<int>("rtu_rts_delay_us");
+    c.rtu.drive_turnaround_s = ctx.param<double>("rtu_turnaround_s");
+    c.cycle_rate_hz = ctx.param<double>("cycle_rate_hz");
+    c.command_timeout_s = ctx.param<double>("command_timeout_s");
+    c.use_write_read_0x17 = ctx.param<bool>("use_write_read_0x17");
+    c.reconnect_backoff_initial_s = ctx.param<double>("reconnect_backoff_initial_s");
+    c.reconnect_backoff_max_s = ctx.param<double>("reconnect_backoff_max_s");
+    c.estop_action = ctx.param<std::string>("estop_action") == "quick_stop"
+                         ? EstopAction::quick_stop
+                         : EstopAction::disable_operation;
+    c.auto_fault_reset = ctx.param<bool>("auto_fault_reset");
+
+    const std::vector<std::string> names = split_names(ctx.param<std::string>("axis_names"));
+    if (names.empty()) throw ConfigError("servo_drive: axis_names is empty");
+    const auto unit_ids = ctx.param<std::vector<double>>("unit_ids");
+    const auto max_torque = ctx.param<std::vector<double>>("max_torque_nm");
+    const auto motor_max = ctx.param<std::vector<double>>("motor_max_torque_nm");
+    const auto lower = ctx.param<std::vector<double>>("soft_lower_rad");
+    const auto upper = ctx.param<std::vector<double>>("soft_upper_rad");
+    const auto brake_gain = ctx.param<std::vector<double>>("brake_gain_nm_s_per_rad");
+    const std::string map_file = ctx.param<std::string>("register_map");
+    std::vector<RegisterMap> maps;
+    if (!map_file.empty()) {
+      maps = load_maps(map_file, names);
+    } else {
+      // The simulated amplifier's maps: scales depend on the axis (rated torque, encoder).
+      for (const std::string& name : names) {
+        if (name != "pan" && name != "tilt") {
+          throw ConfigError("servo_drive: axis '" + name +
+                            "' has no default register map (only pan and tilt do): set "
+                            "register_map");
+        }
+        const bool pan = name == "pan";
+        const AxisPlant plant(pan ? pan_plant_config() : tilt_plant_config());
+        maps.push_back(default_register_map(pan ? pan_rated_torque_nm : tilt_rated_torque_nm,
+                                            plant.output_rad_per_count()));
+      }
+    }
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      DriveAxisConfig axis;
+      axis.name = names[i];
+      axis.unit_id = static_cast<int>(element(unit_ids, i, "unit_ids"));
+      axis.registers = maps[i];
+      axis.safety.configured_max_torque_nm = element(max_torque, i, "max_torque_nm");
+      axis.safety.motor_max_torque_nm = element(motor_max, i, "motor_max_torque_nm");
+      axis.safety.soft_lower_rad = element(lower, i, "soft_lower_rad");
+      axis.safety.soft_upper_rad = element(upper, i, "soft_upper_rad");
+      axis.safety.brake_zone_rad = ctx.param<double>("brake_zone_rad");
+      axis.safety.brake_gain_nm_s_per_rad = element(brake_gain, i, "brake_gain_nm_s_per_rad");
+      if (!(axis.safety.soft_lower_rad < axis.safety.soft_upper_rad)) {
+        throw ConfigError("servo_drive: axis " + axis.name +
+                          ": soft_lower_rad must be below "
+                          "soft_upper_rad");
+      }
+      c.axes.push_back(axis);
+    }
+    const double timeout = ctx.param<double>("response_timeout_s");
+    const double period_s = 1.0 / c.cycle_rate_hz;
+    if (ctx.uses_sim_time()) {
+      // Waiting for a reply costs wall time only: simulated time stands still meanwhile.
+      c.require_timeout_within_period = false;
+      c.response_timeout_s = timeout > 0 ? timeout : 1.0;
+    } else {
+      c.response_timeout_s =
+          timeout > 0 ? timeout : 0.4 * period_s / static_cast<double>(c.axes.size());
+    }
+    return c;
+  }
+
+  std::string describe_link() const {
+    const DriveClientConfig& c = client_->config();
+    std::string axes;
+    for (const DriveAxisConfig& a : c.axes) {
+      axes += (axes.empty() ? "" : ", ") + a.name + " unit " + std::to_string(a.unit_id);
+    }
+    char rate[64];
+    std::snprintf(rate, sizeof rate, " at %.0f Hz (%s), response timeout %.3g s", c.cycle_rate_hz,
+                  own_thread_ ? "own thread" : "container timer", c.response_timeout_s);
+    const std::string peer = c.transport == Transport::tcp
+                                 ? "tcp " + c.tcp.host + ":" + std::to_string(c.tcp.port)
+                                 : "rtu " + c.rtu.device;
+    return peer + " [" + axes + "]" + rate;
+  }
+
+  void on_command(const msgs::avs_msgs::JointTorqueCommand& m) {
+    const auto torques = runtime::as_span(m.torque_nm);
+    const auto names = runtime::as_span(m.name);
+    std::vector<double> command(names_.size(), 0.0);
+    if (names.empty()) {
+      for (std::size_t i = 0; i < std::min(command.size(), torques.size()); ++i) {
+        command[i] = torques[i];
+      }
+    } else {
+      for (std::size_t j = 0; j < names.size() && j < torques.size(); ++j) {
+        const std::string_view name = runtime::get_string(names[j]);
+        const auto it = std::find(names_.begin(), names_.end(), name);
+        if (it == names_.end()) {
+          if (!warned_unknown_joint_) log().warn("torque command for unknown joint '", name, "'");
+          warned_unknown_joint_ = true;
+          continue;
+        }
+        command[static_cast<std::size_t>(it - names_.begin())] = torques[j];
+      }
+    }
+    client_->set_command(command, runtime::from_ros_time(m.header.stamp).seconds());
+  }
+
+  void on_estop(bool active) {
+    if (active != estop_.load()) log().warn(active ? "e-stop engaged" : "e-stop released");
+    estop_ = active;
+    client_->set_estop(active, context().now().seconds());
+  }
+
+  void thread_loop() {
+    if (rt_priority_ > 0) {
+      sched_param param{};
+      param.sched_priority = rt_priority_;
+      const int rc = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+      if (rc != 0) {
+        log().warn("SCHED_FIFO priority ", rt_priority_, " refused (", std::strerror(rc),
+                   "): running with normal scheduling");
+      }
+    }
+    using Clock = std::chrono::steady_clock;
+    auto next = Clock::now() + period_;
+    while (!stop_) {
+      std::this_thread::sleep_until(next);
+      try {
+        run_cycle();
+      } catch (const std::exception& e) {
+        log().error(e.what(), ": cyclic thread stopped, torque off");
+        return;
+      }
+      next += period_;
+      const auto now = Clock::now();
+      if (now > next + 10 * period_) next = now + period_;  // no burst after a long stall
+    }
+  }
+
+  void stop_thread() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+  void run_cycle() {
+    const runtime::Time now = context().now();
+    const CycleResult r = client_->cycle(now.seconds());
+    if (!client_->fatal_error().empty()) throw ConfigError(client_->fatal_error());
+    ++cycles_;
+    const bool fault = r.link_fault || !r.fault_message.empty();
+    if (r.link_fault) {
+      ++link_fault_cycles_;
+      if (first_link_fault_s_ < 0) first_link_fault_s_ = now.seconds();
+      last_link_fault_s_ = now.seconds();
+    }
+    if (fault && r.fault_message != last_message_) {
+      log().warn(r.fault_message.empty() ? "fault" : r.fault_message);
+      if (first_fault_message_.empty()) first_fault_message_ = r.fault_message;
+    }
+    if (!fault && last_fault_) log().info("link and drives healthy again");
+    last_message_ = fault ? r.fault_message : std::string();
+    const bool changed = cycles_ == 1 || fault != last_fault_ || r.link_ok != last_link_ok_;
+    last_fault_ = fault;
+    last_link_ok_ = r.link_ok;
+
+    if (r.link_ok) publish_joint_states(now, r);
+    if (changed || cycles_ % cycles_per_status_ == 0) publish_status(now, r);
+    if (!report_dir_.empty()) record(now, r, fault);
+  }
+
+  void publish_joint_states(runtime::Time now, const CycleResult& r) {
+    auto msg = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    runtime::to_ros_time(now, msg->header.stamp);
+    runtime::set_string(msg->header.frame_id, "head");
+    const auto n = static_cast<std::uint32_t>(r.axes.size());
+    runtime::resize_sequence(msg->name, n);
+    runtime::resize_sequence(msg->position, n);
+    runtime::resize_sequence(msg->velocity, n);
+    runtime::resize_sequence(msg->effort, n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      runtime::set_string(msg->name._buffer[i], names_[i]);
+      msg->position._buffer[i] = r.axes[i].q_rad;
+      msg->velocity._buffer[i] = r.axes[i].qd_rad_s;
+      msg->effort._buffer[i] = r.axes[i].torque_actual_nm;
+    }
+    joint_states_.publish(std::move(msg));
+  }
+
+  void publish_status(runtime::Time now, const CycleResult& r) {
+    const LinkStatistics s = client_->statistics();
+    auto msg = runtime::make_sample<msgs::avs_msgs::DriveStatus>();
+    runtime::to_ros_time(now, msg->header.stamp);
+    const auto n = static_cast<std::uint32_t>(r.axes.size());
+    runtime::resize_sequence(msg->axes, n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      auto& a = msg->axes._buffer[i];
+      const AxisFeedback& fb = r.axes[i];
+      runtime::set_string(a.name, names_[i]);
+      a.statusword = fb.statusword;
+      a.controlword = fb.controlword;
+      a.state = static_cast<std::uint8_t>(fb.state);
+      a.fault = r.link_fault || fb.state == DriveState::fault ||
+                fb.state == DriveState::fault_reaction_active;
+      a.error_code = fb.error_code;
+      a.commanded_torque_nm = fb.commanded_torque_nm;
+    }
+    msg->link_ok = r.link_ok;
+    msg->exchanges = s.exchanges;
+    msg->timeouts = s.timeouts;
+    msg->errors = s.errors + s.exceptions + s.stale_replies;
+    msg->reconnects = s.reconnects;
+    msg->rtt_us_p50 = std::isnan(s.rtt_us_p50) ? 0.0 : s.rtt_us_p50;
+    msg->rtt_us_p99 = std::isnan(s.rtt_us_p99) ? 0.0 : s.rtt_us_p99;
+    drive_status_.publish(std::move(msg));
+  }
+
+  // Test report: one CSV row per cycle (simulated-time runs are reproducible to the bit).
+  void record(runtime::Time now, const CycleResult& r, bool fault) {
+    char line[160];
+    std::snprintf(line, sizeof line, "%.6f,%d,%d,%d", now.seconds(), r.link_ok ? 1 : 0,
+                  fault ? 1 : 0, estop_.load() ? 1 : 0);
+    csv_ += line;
+    for (const AxisFeedback& a : r.axes) {
+      std::snprintf(line, sizeof line, ",%.9g,%.9g,%.9g,%d,%d", a.commanded_torque_nm, a.q_rad,
+                    a.qd_rad_s, static_cast<int>(a.state), a.error_code);
+      csv_ += line;
+    }
+    csv_ += '\n';
+  }
+
+  void write_report(const LinkStatistics& s) {
+    if (report_dir_.empty()) return;
+    const std::string base = report_dir_ + "/" + context().name();
+    std::ofstream csv(base + ".csv");
+    csv << "t_s,link_ok,fault,estop";
+    for (const std::string& n : names_) {
+      csv << ',' << n << "_cmd_nm," << n << "_q_rad," << n << "_qd_rad_s," << n << "_state," << n
+          << "_error_code";
+    }
+    csv << '\n' << csv_;
+    std::ofstream yaml(base + ".yaml");
+    yaml << "cycles: " << cycles_ << "\nlink_fault_cycles: " << link_fault_cycles_
+         << "\nfirst_link_fault_s: " << first_link_fault_s_
+         << "\nlast_link_fault_s: " << last_link_fault_s_ << "\nexchanges: " << s.exchanges
+         << "\ntimeouts: " << s.timeouts << "\nexceptions: " << s.exceptions
+         << "\nstale_replies: " << s.stale_replies << "\nerrors: " << s.errors
+         << "\nreconnects: " << s.reconnects << "\nconnect_failures: " << s.connect_failures
+         << "\nfirst_fault_message: \"" << first_fault_message_ << "\"\n";
+    if (!csv || !yaml) log().error("cannot write the report to ", base, ".{csv,yaml}");
+  }
+
+  runtime::Publisher<msgs::sensor_msgs::JointState> joint_states_;
+  runtime::Publisher<msgs::avs_msgs::DriveStatus> drive_status_;
+  bool own_thread_;
+  int rt_priority_;
+  std::string report_dir_;
+  std::vector<std::string> names_;
+  std::unique_ptr<DriveClient> client_;
+  runtime::Duration period_{1'000'000};
+  std::int64_t cycles_per_status_ = 100;
+  runtime::TimerId timer_ = 0;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> estop_{false};
+  bool warned_unknown_joint_ = false;
+
+  // Cycle bookkeeping (cycle thread / timer only).
+  std::int64_t cycles_ = 0;
+  std::int64_t link_fault_cycles_ = 0;
+  double first_link_fault_s_ = -1;
+  double last_link_fault_s_ = -1;
+  bool last_fault_ = false;
+  bool last_link_ok_ = false;
+  std::string last_message_;
+  std::string first_fault_message_;
+  std::string csv_;
+};
+
+AVS_REGISTER_COMPONENT(ServoDrive);
+
+}  // namespace avs::servo

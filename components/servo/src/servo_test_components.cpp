@@ -1,0 +1,178 @@
+// Small components for the servo graph tests (tests/integration_servo/):
+//   test_torque_step   - publishes a torque command schedule (zero, a step, zero) and an
+//                        optional e-stop window on the container clock;
+//   test_head_recorder - records /sim/head_state and /head/joint_states to CSV files
+//                        <report_dir>/<name>_sim.csv and <name>_joints.csv on deactivate.
+#include <cstdio>
+#include <fstream>
+
+#include "avs/runtime/component.hpp"
+
+namespace avs::servo {
+
+using runtime::ComponentContext;
+using runtime::ComponentSpec;
+using runtime::ParamSpec;
+
+class TestTorqueStep final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    runtime::QosProfile keep_last_1;
+    keep_last_1.depth = 1;
+    runtime::QosProfile estop_qos = keep_last_1;
+    estop_qos.durability = runtime::Durability::transient_local;
+    return {
+        .type = "test_torque_step",
+        .description =
+            "tests: publishes /head/torque_command (torque_nm inside "
+            "[step_at_s, step_until_s), else 0) and an e-stop window",
+        .parameters = {ParamSpec::real("rate_hz", 1000.0, 0.1, 100000.0, "Hz", "command rate"),
+                       ParamSpec::string("joint_names", "pan,tilt",
+                                         "comma-separated joint names (at most 2)"),
+                       ParamSpec::real_list("torque_nm", {0.5, 0.0}, "N m",
+                                            "motor torque per joint during the step"),
+                       ParamSpec::real("step_at_s", 0.1, 0.0, std::nullopt, "s",
+                                       "step start (container clock)"),
+                       ParamSpec::real("step_until_s", 0.12, 0.0, std::nullopt, "s", "step end"),
+                       ParamSpec::real("estop_at_s", -1.0, -1.0, std::nullopt, "s",
+                                       "publish e-stop true at this time (-1 = never)"),
+                       ParamSpec::real("estop_release_s", -1.0, -1.0, std::nullopt, "s",
+                                       "publish e-stop false at this time (-1 = never)")},
+        .publishes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
+                          "torque_command", "/head/torque_command", keep_last_1),
+                      runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos)},
+        .subscribes = {}};
+  }
+
+  explicit TestTorqueStep(ComponentContext& ctx)
+      : Component(ctx),
+        command_(ctx.publisher<msgs::avs_msgs::JointTorqueCommand>("torque_command")),
+        estop_(ctx.publisher<msgs::std_msgs::Bool>("estop")),
+        period_(static_cast<std::int64_t>(1e9 / ctx.param<double>("rate_hz"))),
+        torque_(ctx.param<std::vector<double>>("torque_nm")),
+        step_at_s_(ctx.param<double>("step_at_s")),
+        step_until_s_(ctx.param<double>("step_until_s")),
+        estop_at_s_(ctx.param<double>("estop_at_s")),
+        estop_release_s_(ctx.param<double>("estop_release_s")) {
+    const std::string names = ctx.param<std::string>("joint_names");
+    for (std::size_t start = 0; start <= names.size();) {
+      const std::size_t comma = std::min(names.find(',', start), names.size());
+      if (comma > start) names_.push_back(names.substr(start, comma - start));
+      start = comma + 1;
+    }
+    if (names_.size() != torque_.size()) {
+      throw std::invalid_argument("joint_names has " + std::to_string(names_.size()) +
+                                  " names but torque_nm " + std::to_string(torque_.size()) +
+                                  " values");
+    }
+  }
+
+  void on_activate() override {
+    context().create_timer(period_, [this] { tick(); });
+  }
+
+ private:
+  void tick() {
+    const runtime::Time now = context().now();
+    const double t = now.seconds();
+    if (estop_at_s_ >= 0 && !estop_sent_ && t >= estop_at_s_) {
+      publish_estop(true);
+      estop_sent_ = true;
+    }
+    if (estop_release_s_ >= 0 && !release_sent_ && t >= estop_release_s_) {
+      publish_estop(false);
+      release_sent_ = true;
+    }
+    const bool on = t >= step_at_s_ && t < step_until_s_;
+    auto msg = runtime::make_sample<msgs::avs_msgs::JointTorqueCommand>();
+    runtime::to_ros_time(now, msg->header.stamp);
+    const auto n = static_cast<std::uint32_t>(names_.size());
+    runtime::resize_sequence(msg->name, n);
+    runtime::resize_sequence(msg->torque_nm, n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      runtime::set_string(msg->name._buffer[i], names_[i]);
+      msg->torque_nm._buffer[i] = on ? torque_[i] : 0.0;
+    }
+    command_.publish(std::move(msg));
+  }
+
+  void publish_estop(bool active) {
+    auto msg = runtime::make_sample<msgs::std_msgs::Bool>();
+    msg->data = active;
+    estop_.publish(std::move(msg));
+  }
+
+  runtime::Publisher<msgs::avs_msgs::JointTorqueCommand> command_;
+  runtime::Publisher<msgs::std_msgs::Bool> estop_;
+  runtime::Duration period_;
+  std::vector<double> torque_;
+  std::vector<std::string> names_;
+  double step_at_s_;
+  double step_until_s_;
+  double estop_at_s_;
+  double estop_release_s_;
+  bool estop_sent_ = false;
+  bool release_sent_ = false;
+};
+
+class TestHeadRecorder final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    return {
+        .type = "test_head_recorder",
+        .description = "tests: records /sim/head_state and /head/joint_states to CSV",
+        .parameters = {ParamSpec::string("report_dir", "",
+                                         "folder for <name>_sim.csv and <name>_joints.csv "
+                                         "(written on deactivate); empty = none")},
+        .publishes = {},
+        .subscribes = {
+            runtime::port<msgs::sensor_msgs::JointState>("head_state", "/sim/head_state"),
+            runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states")}};
+  }
+
+  explicit TestHeadRecorder(ComponentContext& ctx)
+      : Component(ctx), report_dir_(ctx.param<std::string>("report_dir")) {
+    ctx.subscribe<msgs::sensor_msgs::JointState>(
+        "head_state",
+        [this](runtime::SamplePtr<msgs::sensor_msgs::JointState> m) { append(sim_, *m); });
+    ctx.subscribe<msgs::sensor_msgs::JointState>(
+        "joint_states",
+        [this](runtime::SamplePtr<msgs::sensor_msgs::JointState> m) { append(joints_, *m); });
+  }
+
+  void on_deactivate() override {
+    if (report_dir_.empty()) return;
+    write(report_dir_ + "/" + context().name() + "_sim.csv", sim_);
+    write(report_dir_ + "/" + context().name() + "_joints.csv", joints_);
+  }
+
+ private:
+  static void append(std::string& out, const msgs::sensor_msgs::JointState& m) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.6f", runtime::from_ros_time(m.header.stamp).seconds());
+    out += text;
+    for (std::uint32_t i = 0; i < m.position._length; ++i) {
+      const double qd = i < m.velocity._length ? m.velocity._buffer[i] : 0.0;
+      const double effort = i < m.effort._length ? m.effort._buffer[i] : 0.0;
+      std::snprintf(text, sizeof text, ",%.12g,%.12g,%.12g", m.position._buffer[i], qd, effort);
+      out += text;
+    }
+    out += '\n';
+  }
+
+  void write(const std::string& file, const std::string& rows) {
+    std::ofstream out(file);
+    out << "t_s,pan_q_rad,pan_qd_rad_s,pan_effort_nm,tilt_q_rad,tilt_qd_rad_s,tilt_effort_nm\n"
+        << rows;
+    if (!out) log().error("cannot write ", file);
+  }
+
+  std::string report_dir_;
+  std::string sim_;
+  std::string joints_;
+};
+
+AVS_REGISTER_COMPONENT(TestTorqueStep);
+AVS_REGISTER_COMPONENT(TestHeadRecorder);
+
+}  // namespace avs::servo
