@@ -236,7 +236,7 @@ TEST(RunFiles, MissingFilesAndBadSnapshotsAreNamed) {
 TEST(RunRecorder, RejectsBadInput) {
   TempDir tmp("recorder");
   EXPECT_THROW(RunRecorder(tmp.path(), {"x", "y", "dodecahedron", ""}), ReportError);
-  RunRecorder recorder(tmp.path(), {});
+  RunRecorder recorder(tmp.path(), {.scenario = "ken", .object = "ken", .symmetry = "none"});
   FrameRow row;
   row.t_s = 2.0;
   recorder.write_frame(row);

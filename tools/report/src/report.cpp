@@ -128,9 +128,10 @@ Report make_report(const fs::path& dir, const ReportOptions& options) {
   return report;
 }
 
-int report_main(const fs::path& dir, std::ostream& out, std::ostream& err) {
+int report_main(const fs::path& dir, std::ostream& out, std::ostream& err,
+                const ReportOptions& options) {
   try {
-    const Report report = make_report(dir);
+    const Report report = make_report(dir, options);
     out << "avs report: " << report.info.scenario << " (" << report.info.object << "), "
         << format_figure(report.summary.frames) << " depth updates\n\n"
         << format_comparison_table(report.info.scenario, report.summary) << "\n";

@@ -79,4 +79,18 @@ std::string format_comparison_table(const std::string& scenario, const Summary& 
   return table.render();
 }
 
+std::string format_comparison_markdown(const std::string& scenario, const Summary& summary) {
+  const auto cell = [](std::string text) {
+    std::string out;
+    for (const char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+  };
+  std::string out = "| figure | paper | ours | unit | section |\n|---|---:|---:|---|---|\n";
+  for (const ComparisonRow& row : comparison_rows(scenario, summary)) {
+    out += "| " + cell(row.label) + " | " + cell(row.paper) + " | " + format_figure(row.ours) +
+           " | " + cell(row.unit) + " | " + cell(row.section) + " |\n";
+  }
+  return out;
+}
+
 }  // namespace avs::report

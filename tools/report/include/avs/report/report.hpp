@@ -39,7 +39,8 @@ struct Report {
 
 /// `avs report DIR`: makes the report, prints the results table and where the page is.
 /// Returns 0, or 1 on an error (printed to `err`) or when a figure failed.
-int report_main(const std::filesystem::path& dir, std::ostream& out, std::ostream& err);
+int report_main(const std::filesystem::path& dir, std::ostream& out, std::ostream& err,
+                const ReportOptions& options = {});
 int report_main(const std::filesystem::path& dir);  ///< std::cout, std::cerr
 
 /// `avs experiments --json`: one object keyed by scenario name, each value as to_json.

@@ -28,4 +28,8 @@ class TextTable {
 [[nodiscard]] std::string format_comparison_table(const std::string& scenario,
                                                   const Summary& summary);
 
+/// The same table as GitHub-flavoured Markdown (for docs/experiments.md).
+[[nodiscard]] std::string format_comparison_markdown(const std::string& scenario,
+                                                     const Summary& summary);
+
 }  // namespace avs::report

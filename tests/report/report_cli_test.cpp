@@ -1,0 +1,56 @@
+// `avs report DIR` as wired by tools/avs/report_cmd.cpp, driven through CLI11 here (main.cpp
+// is the lead's: it only adds the one add_report_command line).
+#include <gtest/gtest.h>
+
+#include <CLI/CLI.hpp>
+
+#include "avs/report/plots.hpp"
+#include "avs/report/run_data.hpp"
+#include "synthetic_run.hpp"
+
+namespace avs::cli {
+void add_report_command(CLI::App& app);
+int& exit_status() {
+  static int status = 0;
+  return status;
+}
+}  // namespace avs::cli
+
+namespace avs::report {
+namespace {
+
+int run_cli(std::vector<std::string> words) {
+  CLI::App app{"avs"};
+  app.require_subcommand(1);
+  avs::cli::add_report_command(app);
+  std::vector<const char*> argv{"avs"};
+  for (const auto& w : words) argv.push_back(w.c_str());
+  avs::cli::exit_status() = -1;
+  app.parse(static_cast<int>(argv.size()), argv.data());
+  return avs::cli::exit_status();
+}
+
+TEST(ReportCommand, MakesTheReportOfARunFolder) {
+  testing::TempDir tmp("cli");
+  {
+    RunRecorder recorder(tmp.path(), {"ken", "ken", "none", ""});
+    testing::SyntheticOptions options;
+    options.frames = 200;
+    for (const FrameRow& row : testing::make_frames(options)) recorder.write_frame(row);
+  }
+  EXPECT_EQ(run_cli({"report", tmp.path().string(), "--width", "640", "--height", "480"}), 0);
+  int width = 0, height = 0;
+  ASSERT_TRUE(read_png_size(tmp.path() / "fig15_position.png", width, height));
+  EXPECT_EQ(width, 640);
+  EXPECT_EQ(height, 480);
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() / kIndexFile));
+}
+
+TEST(ReportCommand, FailsOnAFolderWithoutData) {
+  testing::TempDir tmp("cli_empty");
+  EXPECT_EQ(run_cli({"report", tmp.path().string()}), 1);
+  EXPECT_THROW(run_cli({"report"}), CLI::ParseError);
+}
+
+}  // namespace
+}  // namespace avs::report
