@@ -220,7 +220,11 @@ TEST(Tables, TextTableAlignsColumns) {
   TextTable table({"a", "bb"});
   table.add_row({"long label", "1.5"});
   table.add_row({"x", "100"});
-  EXPECT_EQ(table.render(), "a           bb\n---------------\nlong label  1.5\nx           100\n");
+  EXPECT_EQ(table.render(), "a            bb\n---------------\nlong label  1.5\nx           100\n");
+  TextTable mixed({"k", "v"});
+  mixed.add_row({"a", "about 1"});
+  mixed.add_row({"b", "2"});
+  EXPECT_EQ(mixed.render(), "k  v\n----------\na  about 1\nb  2\n");
   EXPECT_THROW(table.add_row({"one"}), ReportError);
   EXPECT_EQ(format_figure(kUndefined), "-");
   EXPECT_EQ(format_figure(500.0), "500");

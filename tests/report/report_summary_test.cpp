@@ -209,6 +209,7 @@ TEST(Summary, EveryFieldIsInTheJson) {
     EXPECT_EQ(summary_value(s, field.key), s.*field.member);
   }
   EXPECT_THROW((void)summary_value(s, "no_such_key"), ReportError);
+  EXPECT_EQ(json_string("a\"b\\c\n"), "\"a\\\"b\\\\c\\u000a\"");
 }
 
 }  // namespace

@@ -41,6 +41,10 @@ void write_file(const fs::path& file, const std::string& text) {
   if (!out) throw ReportError(file.string() + ": write failed");
 }
 
+const char* const kPaperNote =
+    "paper: the authors' hardware (Sec. 2: Xeon E5-1630v4, GeForce GTX 1080 Ti, real optics); "
+    "ours: this run, simulated scene, times measured on this machine.";
+
 const char* const kStyle =
     R"(body{font-family:sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:.3em .6em}
@@ -73,7 +77,7 @@ std::string render_index_html(const RunInfo& info, const Summary& summary,
       << "</td><td class=\"num\">" << format_figure(row.ours) << "</td><td>"
       << escape_html(row.unit) << "</td><td>" << escape_html(row.section) << "</td></tr>\n";
   }
-  h << "</table>\n";
+  h << "</table>\n<p>" << escape_html(kPaperNote) << "</p>\n";
 
   // 2. Figures.
   h << "<h2>Figures</h2>\n";
@@ -134,7 +138,7 @@ int report_main(const fs::path& dir, std::ostream& out, std::ostream& err,
     const Report report = make_report(dir, options);
     out << "avs report: " << report.info.scenario << " (" << report.info.object << "), "
         << format_figure(report.summary.frames) << " depth updates\n\n"
-        << format_comparison_table(report.info.scenario, report.summary) << "\n";
+        << format_comparison_table(report.info.scenario, report.summary) << kPaperNote << "\n\n";
     for (const SkippedPlot& s : report.plots.skipped) {
       out << "not made: " << s.png << " (" << s.reason << ")\n";
     }

@@ -274,9 +274,26 @@ double summary_value(const Summary& summary, const std::string& key) {
   throw ReportError("unknown summary key '" + key + "'");
 }
 
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buffer[8];
+      std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
+      out += buffer;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
 std::string to_json(const Summary& summary, const std::string& scenario) {
   std::ostringstream out;
-  out << "{\"scenario\": \"" << scenario << "\"";
+  out << "{\"scenario\": " << json_string(scenario);
   for (const SummaryField& field : summary_fields()) {
     const double value = summary.*field.member;
     out << ", \"" << field.key << "\": ";

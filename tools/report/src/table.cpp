@@ -32,29 +32,33 @@ void TextTable::add_row(std::vector<std::string> cells) {
 }
 
 std::string TextTable::render() const {
+  // A column is right-aligned when every cell in it is a number (or "-").
   std::vector<std::size_t> widths(headers_.size());
+  std::vector<bool> right(headers_.size(), !rows_.empty());
   for (std::size_t c = 0; c < headers_.size(); ++c) {
     widths[c] = display_width(headers_[c]);
-    for (const auto& row : rows_) widths[c] = std::max(widths[c], display_width(row[c]));
+    for (const auto& row : rows_) {
+      widths[c] = std::max(widths[c], display_width(row[c]));
+      if (!looks_numeric(row[c])) right[c] = false;
+    }
   }
   std::string out;
-  const auto emit = [&](const std::vector<std::string>& cells, bool header) {
+  const auto emit = [&](const std::vector<std::string>& cells) {
     for (std::size_t c = 0; c < cells.size(); ++c) {
       const std::size_t pad = widths[c] - display_width(cells[c]);
-      const bool right = !header && looks_numeric(cells[c]);
       if (c > 0) out += "  ";
-      if (right) out.append(pad, ' ');
+      if (right[c]) out.append(pad, ' ');
       out += cells[c];
-      if (!right && c + 1 < cells.size()) out.append(pad, ' ');
+      if (!right[c] && c + 1 < cells.size()) out.append(pad, ' ');
     }
     out += '\n';
   };
-  emit(headers_, true);
+  emit(headers_);
   std::size_t total = 0;
   for (std::size_t w : widths) total += w;
   out.append(total + 2 * (widths.size() - 1), '-');
   out += '\n';
-  for (const auto& row : rows_) emit(row, false);
+  for (const auto& row : rows_) emit(row);
   return out;
 }
 

@@ -98,6 +98,9 @@ struct SummaryField {
 [[nodiscard]] Summary compute_summary(const std::vector<FrameRow>& frames,
                                       const Symmetry& symmetry);
 
+/// `text` as a JSON string literal, quotes included.
+[[nodiscard]] std::string json_string(const std::string& text);
+
 /// One JSON object: {"scenario": "...", "frames": 1000, ...}; NaN as null.
 [[nodiscard]] std::string to_json(const Summary& summary, const std::string& scenario);
 
