@@ -163,8 +163,8 @@ int report_main(const fs::path& dir) {
 std::string experiments_json(const std::vector<std::pair<std::string, Summary>>& runs) {
   std::string out = "{";
   for (std::size_t i = 0; i < runs.size(); ++i) {
-    out +=
-        (i == 0 ? "\"" : ", \"") + runs[i].first + "\": " + to_json(runs[i].second, runs[i].first);
+    out += (i == 0 ? "" : ", ") + json_string(runs[i].first) + ": " +
+           to_json(runs[i].second, runs[i].first);
   }
   return out + "}";
 }
