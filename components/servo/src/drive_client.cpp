@@ -140,7 +140,8 @@ void DriveClient::open_link() {
     ctx =
         make_rtu_context(r.device, r.line.baud, r.line.parity, r.line.data_bits, r.line.stop_bits);
   }
-  set_response_timeout(ctx.get(), config_.response_timeout_s);
+  set_response_timeout(ctx.get(),
+                       std::max(config_.configure_timeout_s, config_.response_timeout_s));
   const std::string peer = config_.transport == Transport::tcp
                                ? config_.tcp.host + ":" + std::to_string(config_.tcp.port)
                                : config_.rtu.device;
@@ -218,6 +219,7 @@ void DriveClient::connect() {
   open_link();
   try {
     configure_axes();
+    set_response_timeout(ctx_.get(), config_.response_timeout_s);  // cyclic budget from now on
   } catch (...) {
     close_link();
     throw;

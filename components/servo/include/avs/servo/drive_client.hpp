@@ -60,6 +60,10 @@ struct DriveClientConfig {
   /// where the wait costs wall time but no simulated time, and a generous wall timeout keeps a
   /// loaded machine from turning a slow reply into a (non-deterministic) link fault.
   bool require_timeout_within_period = true;
+  /// Response timeout while configuring (connect and reconnect: probe, mode, limits), which is
+  /// not cyclic: a loaded host must not fail the configuration for a reply a little slower than
+  /// the cyclic budget. The larger of this and response_timeout_s applies.
+  double configure_timeout_s = 0.05;
   double command_timeout_s = 0.02;  ///< older commands -> zero torque
   bool use_write_read_0x17 = true;  ///< else 0x10 write(s) + 0x03 read
   double reconnect_backoff_initial_s = 0.005;
