@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "avs/report/summary.hpp"
@@ -261,41 +262,78 @@ bool depth_range(const DepthSnapshot& depth, double& lo_m, double& hi_m) {
 
 }  // namespace
 
+namespace {
+
+/// A started gnuplot process. Reaped by finish(), or by the destructor if never finished.
+class GnuplotChild {
+ public:
+  GnuplotChild(const fs::path& working_dir, const std::string& script, const PlotConfig& config)
+      : working_dir_(working_dir),
+        script_(script),
+        program_(config.gnuplot_program),
+        log_(working_dir / (script + ".stderr")) {
+    SpawnActions actions;
+    posix_spawn_file_actions_addchdir_np(actions.get(), working_dir.c_str());
+    posix_spawn_file_actions_addopen(actions.get(), 0, "/dev/null", O_RDONLY, 0);
+    posix_spawn_file_actions_addopen(actions.get(), 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(actions.get(), 2, log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                     0644);
+    std::vector<std::string> words{program_, script};
+    std::vector<char*> argv;
+    for (auto& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    const int error =
+        posix_spawnp(&pid_, program_.c_str(), actions.get(), nullptr, argv.data(), environ);
+    if (error != 0) {
+      pid_ = -1;
+      throw ReportError("cannot start '" + program_ + "': " + std::strerror(error) +
+                        " (install the Debian package gnuplot-nox)");
+    }
+  }
+  ~GnuplotChild() {
+    if (pid_ > 0) {
+      int status = 0;
+      while (waitpid(pid_, &status, 0) < 0 && errno == EINTR) {
+      }
+    }
+  }
+  GnuplotChild(const GnuplotChild&) = delete;
+  GnuplotChild& operator=(const GnuplotChild&) = delete;
+
+  /// Waits for the exit; returns stderr, throws ReportError unless the exit status is 0.
+  std::string finish() {
+    int status = 0;
+    while (waitpid(pid_, &status, 0) < 0) {
+      if (errno != EINTR) throw ReportError(std::string("waitpid: ") + std::strerror(errno));
+    }
+    pid_ = -1;
+    std::string stderr_text = trim(read_text(log_));
+    std::error_code ec;
+    fs::remove(log_, ec);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      const std::string how = WIFEXITED(status)
+                                  ? "exited with status " + std::to_string(WEXITSTATUS(status))
+                                  : "was killed by signal " + std::to_string(WTERMSIG(status));
+      throw ReportError(program_ + " " + script_ + " (in " + working_dir_.string() + ") " + how +
+                        ": " + stderr_text);
+    }
+    return stderr_text;
+  }
+
+ private:
+  fs::path working_dir_;
+  std::string script_;
+  std::string program_;
+  fs::path log_;
+  pid_t pid_ = -1;
+};
+
+}  // namespace
+
 std::string run_gnuplot(const fs::path& working_dir, const std::string& script,
                         const PlotConfig& config) {
-  const fs::path log = working_dir / (script + ".stderr");
-  SpawnActions actions;
-  posix_spawn_file_actions_addchdir_np(actions.get(), working_dir.c_str());
-  posix_spawn_file_actions_addopen(actions.get(), 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(actions.get(), 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(actions.get(), 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
-  std::vector<std::string> words{config.gnuplot_program, script};
-  std::vector<char*> argv;
-  for (auto& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, config.gnuplot_program.c_str(), actions.get(), nullptr,
-                                 argv.data(), environ);
-  if (error != 0) {
-    throw ReportError("cannot start '" + config.gnuplot_program + "': " + std::strerror(error) +
-                      " (install the Debian package gnuplot-nox)");
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw ReportError(std::string("waitpid: ") + std::strerror(errno));
-  }
-  std::string stderr_text = trim(read_text(log));
-  std::error_code ec;
-  fs::remove(log, ec);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    const std::string how = WIFEXITED(status)
-                                ? "exited with status " + std::to_string(WEXITSTATUS(status))
-                                : "was killed by signal " + std::to_string(WTERMSIG(status));
-    throw ReportError(config.gnuplot_program + " " + script + " (in " + working_dir.string() +
-                      ") " + how + ": " + stderr_text);
-  }
-  return stderr_text;
+  GnuplotChild child(working_dir, script, config);
+  return child.finish();
 }
 
 bool read_png_size(const fs::path& file, int& width, int& height) {
@@ -384,7 +422,9 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
                   !d.any_pose ? "no frame has a pose estimate" : ""});
   if (jobs.back().skip_reason.empty()) jobs.back().body = fig16(head(jobs.back().name, true));
 
-  // 2. Run gnuplot on each; a figure that fails does not stop the others.
+  // 2. Run gnuplot on every figure at once (cairo rendering dominates; the processes share
+  //    the cores); a figure that fails does not stop the others.
+  std::vector<std::pair<const Job*, std::unique_ptr<GnuplotChild>>> running;
   for (const Job& job : jobs) {
     const std::string png = job.name + ".png";
     fs::remove(run.dir / png, ec);  // never show a stale picture from an earlier report
@@ -398,15 +438,19 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
       out << job.body;
       if (!out) throw ReportError((run.dir / script).string() + ": write failed");
     }
+    running.emplace_back(&job, std::make_unique<GnuplotChild>(run.dir, script, config));
+  }
+  for (auto& [job, child] : running) {
+    const std::string png = job->name + ".png";
+    const std::string script = "gnuplot/" + job->name + ".gp";
     try {
-      Plot plot{png, script, job.title, job.caption, run_gnuplot(run.dir, script, config)};
+      Plot plot{png, script, job->title, job->caption, child->finish()};
       int width = 0, height = 0;
       if (!read_png_size(run.dir / png, width, height)) {
         throw ReportError(script + ": gnuplot exited 0 but " + png + " is not a PNG file");
       }
       result.made.push_back(std::move(plot));
     } catch (const ReportError& e) {
-      if (std::string(e.what()).starts_with("cannot start")) throw;
       result.failed.push_back({png, e.what()});
     }
   }
