@@ -165,6 +165,22 @@ TEST(RunFiles, BadNumberNamesFileLineAndColumn) {
   expect_error(tmp.path(), "frames.csv:5: column 'pan_rad': cannot parse 'abc' as a number");
 }
 
+TEST(RunFiles, RowCutShortByAKilledWriterIsDroppedWithAWarning) {
+  TempDir tmp("cut_short");
+  write_run(tmp.path(), 20);
+  std::string text = read_text(tmp.path() / kFramesFile);
+  text += "1.04,3.5,";  // a 22nd row cut off mid-write, no newline
+  write_text(tmp.path() / kFramesFile, text);
+  const RunData run = load_run(tmp.path());
+  EXPECT_EQ(run.frames.size(), 20U);
+  ASSERT_EQ(run.warnings.size(), 1U);
+  EXPECT_NE(run.warnings[0].find("frames.csv:22: last line is cut short"), std::string::npos)
+      << run.warnings[0];
+  // The same row with its newline is a malformed row, not a cut one.
+  write_text(tmp.path() / kFramesFile, text + "\n");
+  expect_error(tmp.path(), "frames.csv:22: expected 28 fields (as in the header), got 3");
+}
+
 TEST(RunFiles, MissingColumnIsReportedOnTheHeaderLine) {
   TempDir tmp("missing_column");
   write_run(tmp.path());

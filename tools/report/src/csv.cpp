@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <system_error>
 
 #include "avs/report/run_data.hpp"
@@ -31,29 +32,43 @@ std::string format_number(double value) {
 }
 
 Table Table::read(const std::filesystem::path& file) {
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw ReportError(file.string() + ": cannot open for reading");
+  std::ostringstream contents;
+  contents << in.rdbuf();
+  const std::string text = contents.str();
   Table table;
   table.file_ = file;
-  std::string line;
+  std::size_t start = 0;
   int line_number = 0;
-  while (std::getline(in, line)) {
+  while (start < text.size()) {
+    std::size_t end = text.find('\n', start);
+    const bool complete = end != std::string::npos;
+    if (!complete) end = text.size();
+    std::string line = text.substr(start, end - start);
+    start = end + 1;
     ++line_number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;  // blank lines (e.g. a trailing one) carry no row
+    const std::string where = file.string() + ":" + std::to_string(line_number);
     if (line.find('"') != std::string::npos) {
-      throw ReportError(file.string() + ":" + std::to_string(line_number) +
-                        ": quoted fields are not supported");
+      throw ReportError(where + ": quoted fields are not supported");
     }
     std::vector<std::string> fields = split(line);
     if (table.header_.empty()) {
       table.header_ = std::move(fields);
       continue;
     }
+    if (!complete && fields.size() < table.header_.size()) {
+      table.warnings_.push_back(where + ": last line is cut short (" +
+                                std::to_string(fields.size()) + " of " +
+                                std::to_string(table.header_.size()) +
+                                " fields, no newline): ignored; the writer stopped mid-row");
+      continue;
+    }
     if (fields.size() != table.header_.size()) {
-      throw ReportError(file.string() + ":" + std::to_string(line_number) + ": expected " +
-                        std::to_string(table.header_.size()) + " fields (as in the header), got " +
-                        std::to_string(fields.size()));
+      throw ReportError(where + ": expected " + std::to_string(table.header_.size()) +
+                        " fields (as in the header), got " + std::to_string(fields.size()));
     }
     table.rows_.push_back(std::move(fields));
     table.lines_.push_back(line_number);

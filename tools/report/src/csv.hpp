@@ -13,7 +13,8 @@ namespace avs::report::csv {
 class Table {
  public:
   /// Reads the whole file. Throws ReportError for a missing file, an empty file, a quoted
-  /// field, or a row whose field count differs from the header's.
+  /// field, or a row whose field count differs from the header's. A last line without its
+  /// newline and with too few fields (a writer stopped mid-row) is dropped with a warning.
   [[nodiscard]] static Table read(const std::filesystem::path& file);
 
   [[nodiscard]] std::size_t rows() const { return rows_.size(); }
@@ -35,12 +36,14 @@ class Table {
   /// "file:line: column 'c': " prefix for errors raised by callers.
   [[nodiscard]] std::string where(std::size_t row, std::size_t col) const;
   [[nodiscard]] std::string where(std::size_t row) const;
+  [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
   std::filesystem::path file_;
   std::vector<std::string> header_;
   std::vector<std::vector<std::string>> rows_;
   std::vector<int> lines_;
+  std::vector<std::string> warnings_;
 };
 
 /// Splits one line at commas (no quoting).

@@ -54,8 +54,8 @@ figcaption{color:#444;margin-top:.4em}.warn{color:#a00}code{background:#f4f4f4;p
 
 }  // namespace
 
-std::string render_index_html(const RunInfo& info, const Summary& summary,
-                              const PlotResult& plots) {
+std::string render_index_html(const RunInfo& info, const Summary& summary, const PlotResult& plots,
+                              const std::vector<std::string>& warnings) {
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
     << "<title>avs report: " << escape_html(info.scenario) << "</title>\n<style>\n"
@@ -68,6 +68,9 @@ std::string render_index_html(const RunInfo& info, const Summary& summary,
        "<a href=\"frames.csv\">frames.csv</a> by <code>avs report</code>; the paper's column "
        "quotes Sec. 7 of the paper.</p>\n";
   if (!info.notes.empty()) h << "<p>" << escape_html(info.notes) << "</p>\n";
+  for (const std::string& warning : warnings) {
+    h << "<p class=\"warn\">" << escape_html(warning) << "</p>\n";
+  }
 
   // 1. Results: the paper beside ours.
   h << "<h2>Results</h2>\n<table>\n<tr><th>figure</th><th>paper</th><th>ours</th><th>unit</th>"
@@ -123,12 +126,14 @@ Report make_report(const fs::path& dir, const ReportOptions& options) {
   Report report;
   const RunData run = load_run(dir);
   report.info = run.info;
+  report.warnings = run.warnings;
   report.summary = compute_summary(run);
   report.summary_json = dir / kSummaryFile;
   write_file(report.summary_json, to_json(report.summary, run.info.scenario) + "\n");
   report.plots = make_plots(run, options.plots);
   report.index_html = dir / kIndexFile;
-  write_file(report.index_html, render_index_html(run.info, report.summary, report.plots));
+  write_file(report.index_html,
+             render_index_html(run.info, report.summary, report.plots, run.warnings));
   return report;
 }
 
@@ -139,6 +144,7 @@ int report_main(const fs::path& dir, std::ostream& out, std::ostream& err,
     out << "avs report: " << report.info.scenario << " (" << report.info.object << "), "
         << format_figure(report.summary.frames) << " depth updates\n\n"
         << format_comparison_table(report.info.scenario, report.summary) << kPaperNote << "\n\n";
+    for (const std::string& warning : report.warnings) err << "warning: " << warning << "\n";
     for (const SkippedPlot& s : report.plots.skipped) {
       out << "not made: " << s.png << " (" << s.reason << ")\n";
     }

@@ -52,8 +52,9 @@ std::array<std::size_t, 7> pose_columns(const csv::Table& table, const std::stri
   return cols;
 }
 
-std::vector<FrameRow> read_frames(const fs::path& file) {
+std::vector<FrameRow> read_frames(const fs::path& file, std::vector<std::string>& warnings) {
   const csv::Table table = csv::Table::read(file);
+  warnings.insert(warnings.end(), table.warnings().begin(), table.warnings().end());
   const std::size_t c_t = table.column("t_s");
   const std::size_t c_cx = table.column("centroid_x_px");
   const std::size_t c_cy = table.column("centroid_y_px");
@@ -178,8 +179,9 @@ DepthSnapshot read_depth(const fs::path& dir) {
   return depth;
 }
 
-std::vector<CloudSnapshot> read_clouds(const fs::path& file) {
+std::vector<CloudSnapshot> read_clouds(const fs::path& file, std::vector<std::string>& warnings) {
   const csv::Table table = csv::Table::read(file);
+  warnings.insert(warnings.end(), table.warnings().begin(), table.warnings().end());
   const std::size_t c_snapshot = table.column("snapshot");
   const std::size_t c_t = table.column("t_s");
   const std::size_t c_cloud = table.column("cloud");
@@ -277,9 +279,10 @@ RunData load_run(const fs::path& dir) {
   RunData run;
   run.dir = dir;
   run.info = read_meta(dir / kMetaFile);
-  run.frames = read_frames(dir / kFramesFile);
+  run.frames = read_frames(dir / kFramesFile, run.warnings);
   if (fs::exists(dir / kDepthSnapshotFile)) run.depth = read_depth(dir);
-  if (fs::exists(dir / kCloudsSnapshotFile)) run.clouds = read_clouds(dir / kCloudsSnapshotFile);
+  if (fs::exists(dir / kCloudsSnapshotFile))
+    run.clouds = read_clouds(dir / kCloudsSnapshotFile, run.warnings);
   return run;
 }
 

@@ -20,6 +20,7 @@ struct ReportOptions {
 
 struct Report {
   RunInfo info;
+  std::vector<std::string> warnings;  ///< from load_run
   Summary summary;
   PlotResult plots;
   std::filesystem::path summary_json;
@@ -35,7 +36,8 @@ struct Report {
 /// The page: results table (paper beside ours), every figure made, every figure skipped or
 /// failed with the reason, all figures of the summary, links to the data and scripts.
 [[nodiscard]] std::string render_index_html(const RunInfo& info, const Summary& summary,
-                                            const PlotResult& plots);
+                                            const PlotResult& plots,
+                                            const std::vector<std::string>& warnings = {});
 
 /// `avs report DIR`: makes the report, prints the results table and where the page is.
 /// Returns 0, or 1 on an error (printed to `err`) or when a figure failed.

@@ -106,6 +106,8 @@ struct RunData {
   std::vector<FrameRow> frames;
   std::optional<DepthSnapshot> depth;
   std::vector<CloudSnapshot> clouds;
+  /// Problems that did not stop the load (e.g. a last row cut short by a killed writer).
+  std::vector<std::string> warnings;
 };
 
 /// Reads a run folder. frames.csv and meta.csv are required; the snapshots are optional.
