@@ -108,5 +108,13 @@ TEST(GroundTruth, CameraFramePoseIsWorldPoseSeenFromTheHead) {
   EXPECT_GT(o.twist_world.v_world_mps.norm(), 0.1);  // moving at t = 1.2 s
 }
 
+TEST(Scene, BackgroundPlaneFacesTheHead) {
+  const SceneObject plane = make_background_plane(2.0);
+  const Eigen::Isometry3d T = plane.trajectory->T_world_object(0);
+  EXPECT_NEAR(T.linear().determinant(), 1.0, 1e-12);
+  EXPECT_TRUE((T.linear() * Eigen::Vector3d::UnitZ()).isApprox(-Eigen::Vector3d::UnitX()));
+  EXPECT_TRUE(T.translation().isApprox(Eigen::Vector3d(2.0, 0, 0)));
+}
+
 }  // namespace
 }  // namespace avs::sim

@@ -56,6 +56,59 @@ PinholeView make_view(const decode::LensModel& lens, double scale, double near_m
   return view;
 }
 
+/// Per pixel of a camera row: z from 1/z, and the projector coordinates (u, v) and depth qz of
+/// the point, with q = z (column_term rx + row_term) + t. Pixels with nothing (w = 0) get
+/// z = 0; points not in front of the projector get u = v = -1. No control flow, so the
+/// compiler vectorises it (a free function: inside the member it did not).
+void project_row(int width, const float* __restrict inv_depth, const float* __restrict ray_x,
+                 const Eigen::Vector3f& column_term, const Eigen::Vector3f& row_term,
+                 const Eigen::Vector3f& t, float near, float fx, float fy, float cx, float cy,
+                 float* __restrict z_out, float* __restrict qz_out, float* __restrict u_out,
+                 float* __restrict v_out) {
+  const float ax = column_term.x(), ay = column_term.y(), az = column_term.z();
+  const float bx = row_term.x(), by = row_term.y(), bz = row_term.z();
+  const float tx = t.x(), ty = t.y(), tz = t.z();
+  for (int x = 0; x < width; ++x) {
+    const float w = inv_depth[x];
+    const float seen = static_cast<float>(w > 0.0f);
+    const float z = seen / (w + (1.0f - seen));
+    const float qx = z * (ax * ray_x[x] + bx) + tx;
+    const float qy = z * (ay * ray_x[x] + by) + ty;
+    const float qz = z * (az * ray_x[x] + bz) + tz;
+    const float front = static_cast<float>(qz > near);
+    const float inv_qz = front / (qz + (1.0f - front));
+    z_out[x] = z;
+    qz_out[x] = qz;
+    u_out[x] = front * (fx * qx * inv_qz + cx + 1.0f) - 1.0f;
+    v_out[x] = front * (fy * qy * inv_qz + cy + 1.0f) - 1.0f;
+  }
+}
+
+/// Per pixel of a camera row at depth z with face normal n: base = albedo x ambient and
+/// gain = albedo x projector x cos(normal, direction to the projector) [x falloff], 0 when
+/// the face turns away from the projector. Normals facing away from the camera (back faces
+/// drawn with culling off) are flipped. Vectorised like project_row.
+void shade_row(int width, const float* __restrict ray_x, float ray_y, const float* __restrict z_in,
+               const float* __restrict nx, const float* __restrict ny, const float* __restrict nz,
+               const float* __restrict albedo, const Eigen::Vector3f& projector_centre,
+               float ambient, float projector_level, float falloff2, float* __restrict base_out,
+               float* __restrict gain_out) {
+  const float c_x = projector_centre.x(), c_y = projector_centre.y(), c_z = projector_centre.z();
+  const float use_falloff = static_cast<float>(falloff2 > 0);
+  for (int x = 0; x < width; ++x) {
+    const float z = z_in[x];
+    const float dx = c_x - ray_x[x] * z, dy = c_y - ray_y * z, dz = c_z - z;
+    const float towards_camera = nx[x] * ray_x[x] + ny[x] * ray_y + nz[x];
+    const float sign = 1.0f - 2.0f * static_cast<float>(towards_camera > 0);
+    const float facing = sign * (nx[x] * dx + ny[x] * dy + nz[x] * dz);
+    const float distance2 = dx * dx + dy * dy + dz * dz + 1e-12f;
+    const float falloff = use_falloff * falloff2 / distance2 + (1.0f - use_falloff);
+    const float cosine = std::max(facing, 0.0f) / std::sqrt(distance2);
+    base_out[x] = albedo[x] * ambient;
+    gain_out[x] = albedo[x] * projector_level * cosine * falloff;
+  }
+}
+
 }  // namespace
 
 std::uint64_t frame_noise_key(std::uint64_t frame_index) {
@@ -105,13 +158,32 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   if (pixels > kNoiseBankSize / 2) {
     throw std::invalid_argument("sim::Renderer: camera larger than 2^19 pixels not supported");
   }
+  row_z_.resize(g.camera.width);
+  row_u_.resize(g.camera.width);
+  row_v_.resize(g.camera.width);
+  row_qz_.resize(g.camera.width);
+  row_nx_.resize(g.camera.width);
+  row_ny_.resize(g.camera.width);
+  row_nz_.resize(g.camera.width);
+  row_albedo_.resize(g.camera.width);
   base_dn_.assign(pixels, 0.0f);
   gain_dn_.assign(pixels, 0.0f);
   gray_.assign(pixels, 0);
-  depth_m_.assign(pixels, 0.0f);
-  projector_row_.assign(pixels, std::numeric_limits<float>::quiet_NaN());
-  object_index_.assign(pixels, -1);
-  code_.assign(pixels, -1);
+  truth_.depth_m.assign(pixels, 0.0f);
+  truth_.projector_row.assign(pixels, std::numeric_limits<float>::quiet_NaN());
+  truth_.object_index.assign(pixels, -1);
+  truth_.code.assign(pixels, -1);
+  truth_.valid = true;  // nothing in view yet
+}
+
+const Renderer::Truth& Renderer::truth() const {
+  if (!truth_.valid) {
+    // Same computation as set_view()'s, with the ground-truth arrays written too.
+    auto* self = const_cast<Renderer*>(this);
+    for (int y = 0; y < camera_view_.height; ++y) self->compute_row<true>(y, &self->truth_);
+    truth_.valid = true;
+  }
+  return truth_;
 }
 
 void Renderer::set_view(const std::vector<RenderObject>& objects) {
@@ -121,7 +193,8 @@ void Renderer::set_view(const std::vector<RenderObject>& objects) {
   // 1. Both depth buffers and the per-triangle data.
   prepare_triangles(objects);
   // 2. Per camera pixel: surface point, shadow test, shading, code.
-  for (int y = 0; y < camera_view_.height; ++y) compute_row(y);
+  for (int y = 0; y < camera_view_.height; ++y) compute_row<false>(y, nullptr);
+  truth_.valid = false;
 }
 
 void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
@@ -156,73 +229,95 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
   }
 }
 
-void Renderer::compute_row(int y) {
+template <bool kWithTruth>
+void Renderer::compute_row(int y, Truth* truth) {
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const int width = camera_view_.width;
+  const std::size_t row_start = static_cast<std::size_t>(y) * width;
+  // Locals, so the compiler need not reload members after every store.
+  const float* inv_depth = camera_buffer_.inv_depth.data() + row_start;
+  const std::int32_t* ids = camera_buffer_.triangle.data() + row_start;
+  const float* ray_x = ray_x_.data();
+  const float ray_y = ray_y_[y];
+  float* base_out = base_dn_.data() + row_start;
+  float* gain_out = gain_dn_.data() + row_start;
+  std::uint16_t* gray_out = gray_.data() + row_start;
+  const Eigen::Vector3f* normals = normal_camera_.data();
+  const float* albedo_dn = triangle_albedo_dn_.data();
+  const std::int16_t* row_code = row_code_.data();
+  const float* shadow_depth = projector_buffer_.inv_depth.data();
+  const std::int32_t* shadow_id = projector_buffer_.triangle.data();
+  const int shadow_width = shadow_view_.width;
   const auto ambient = static_cast<float>(config_.ambient_level);
   const auto projector_level = static_cast<float>(config_.projector_level);
   const auto falloff2 =
       static_cast<float>(config_.falloff_reference_m * config_.falloff_reference_m);
   const auto bias = static_cast<float>(config_.shadow_bias_m);
   const auto scale = static_cast<float>(config_.shadow_map_scale);
+  const auto near = shadow_view_.near_m;
   const auto fx = static_cast<float>(projector_.fx_px), fy = static_cast<float>(projector_.fy_px);
   const auto cx = static_cast<float>(projector_.cx_px), cy = static_cast<float>(projector_.cy_px);
-  const int projector_width = projector_.width, projector_height = projector_.height;
+  const auto u_max = static_cast<float>(projector_.width) - 0.5f;
+  const auto v_max = static_cast<float>(projector_.height) - 0.5f;
   // q = R p + t with p = z (rx, ry, 1): R p = z (R.col(0) rx + R.col(1) ry + R.col(2)).
-  const Eigen::Vector3f row_term =
-      R_projector_camera_.col(1) * ray_y_[y] + R_projector_camera_.col(2);
+  const Eigen::Vector3f row_term = R_projector_camera_.col(1) * ray_y + R_projector_camera_.col(2);
   const Eigen::Vector3f column_term = R_projector_camera_.col(0);
-  const std::size_t row_start = static_cast<std::size_t>(y) * camera_view_.width;
+  const Eigen::Vector3f t = t_projector_camera_m_;
 
-  for (int x = 0; x < camera_view_.width; ++x) {
-    const std::size_t i = row_start + x;
-    const std::int32_t id = camera_buffer_.triangle[i];
-    base_dn_[i] = gain_dn_[i] = 0.0f;
-    gray_[i] = 0;
-    projector_row_[i] = kNaN;
-    code_[i] = -1;
-    if (id < 0) {
-      depth_m_[i] = 0.0f;
-      object_index_[i] = -1;
+  // Pass 1 (branch-free, vectorised): depth and projector coordinates of every pixel.
+  project_row(width, inv_depth, ray_x, column_term, row_term, t, near, fx, fy, cx, cy,
+              row_z_.data(), row_qz_.data(), row_u_.data(), row_v_.data());
+  const float* z_row = row_z_.data();
+  const float* qz_row = row_qz_.data();
+  const float* u_row = row_u_.data();
+  const float* v_row = row_v_.data();
+  // Pass 2: the visible triangle's normal and albedo per pixel (gather).
+  float* nx = row_nx_.data();
+  float* ny = row_ny_.data();
+  float* nz = row_nz_.data();
+  float* albedo = row_albedo_.data();
+  for (int x = 0; x < width; ++x) {
+    const std::int32_t id = ids[x];
+    const Eigen::Vector3f n = id < 0 ? Eigen::Vector3f::Zero() : normals[id];
+    nx[x] = n.x();
+    ny[x] = n.y();
+    nz[x] = n.z();
+    albedo[x] = id < 0 ? 0.0f : albedo_dn[id];
+  }
+  // Pass 3 (vectorised): ambient and projector light before the shadow test.
+  shade_row(width, ray_x, ray_y, z_row, nx, ny, nz, albedo, projector_centre_camera_m_, ambient,
+            projector_level, falloff2, base_out, gain_out);
+  // Pass 4: projector image bounds, coded rows and the shadow test.
+  for (int x = 0; x < width; ++x) {
+    const std::int32_t id = ids[x];
+    gray_out[x] = 0;
+    if constexpr (kWithTruth) {
+      truth->projector_row[row_start + x] = kNaN;
+      truth->code[row_start + x] = -1;
+      truth->depth_m[row_start + x] = id < 0 ? 0.0f : z_row[x];
+      truth->object_index[row_start + x] = id < 0 ? -1 : triangle_object_[id];
+    }
+    if (!(gain_out[x] > 0)) continue;  // nothing seen, or facing away from the projector
+    const float u = u_row[x], v = v_row[x];
+    bool lit = u > -0.5f && u < u_max && v > -0.5f && v < v_max;  // also false behind it
+    const int code = lit ? row_code[static_cast<int>(v + 0.5f)] : -1;
+    if (code >= 0) {
+      const std::size_t j = static_cast<std::size_t>((v + 0.5f) * scale) * shadow_width +
+                            static_cast<std::size_t>((u + 0.5f) * scale);
+      const float w_seen = shadow_depth[j];
+      // Something nearer to the projector covers this point: projector shadow.
+      lit = shadow_id[j] == id || !(w_seen > 0) || qz_row[x] * w_seen <= 1.0f + bias * w_seen;
+    }
+    if (!lit || code < 0) {  // shadowed, outside the projector or an uncoded (dark) row
+      gain_out[x] = 0.0f;
       continue;
     }
-    const float z = 1.0f / camera_buffer_.inv_depth[i];
-    const Eigen::Vector3f p_camera(ray_x_[x] * z, ray_y_[y] * z, z);
-    const float albedo_dn = triangle_albedo_dn_[id];
-    depth_m_[i] = z;
-    object_index_[i] = triangle_object_[id];
-    base_dn_[i] = albedo_dn * ambient;
-
-    // Shading: cosine between the face normal and the direction to the projector.
-    Eigen::Vector3f normal = normal_camera_[id];
-    if (normal.dot(p_camera) > 0) normal = -normal;  // back face, drawn with culling off
-    const Eigen::Vector3f to_projector = projector_centre_camera_m_ - p_camera;
-    const float facing = normal.dot(to_projector);
-    if (!(facing > 0)) continue;
-    // Projection into the projector and the shadow test against its depth buffer.
-    const Eigen::Vector3f q = z * (column_term * ray_x_[x] + row_term) + t_projector_camera_m_;
-    if (q.z() < shadow_view_.near_m) continue;
-    const float inv_qz = 1.0f / q.z();
-    const float u = fx * q.x() * inv_qz + cx, v = fy * q.y() * inv_qz + cy;
-    if (!(u > -0.5f && u < projector_width - 0.5f && v > -0.5f && v < projector_height - 0.5f))
-      continue;
-    const int row = static_cast<int>(v + 0.5f);
-    const int code = row_code_[row];
-    if (code < 0) continue;  // uncoded rows are dark
-    const int cell_x = static_cast<int>((u + 0.5f) * scale),
-              cell_y = static_cast<int>((v + 0.5f) * scale);
-    const std::size_t j = static_cast<std::size_t>(cell_y) * shadow_view_.width + cell_x;
-    const float w_seen = projector_buffer_.inv_depth[j];
-    if (projector_buffer_.triangle[j] != id && w_seen > 0 &&
-        q.z() * w_seen > 1.0f + bias * w_seen) {
-      continue;  // something nearer to the projector covers this point: projector shadow
+    if constexpr (kWithTruth) {
+      truth->projector_row[row_start + x] = v;
+      truth->code[row_start + x] = static_cast<std::int16_t>(code);
     }
-    const float distance2 = to_projector.squaredNorm();
-    float irradiance = projector_level * facing / std::sqrt(distance2);
-    if (falloff2 > 0) irradiance *= falloff2 / distance2;
-    projector_row_[i] = v;
-    code_[i] = static_cast<std::int16_t>(code);
-    gray_[i] = static_cast<std::uint16_t>(decode::binary_to_gray(static_cast<std::uint32_t>(code)));
-    gain_dn_[i] = albedo_dn * irradiance;
+    gray_out[x] =
+        static_cast<std::uint16_t>(decode::binary_to_gray(static_cast<std::uint32_t>(code)));
   }
 }
 

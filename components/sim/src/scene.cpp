@@ -35,11 +35,11 @@ GroundTruth ground_truth(const Scene& scene, const HeadConfig& head, double t_s,
 SceneObject make_background_plane(double distance_m, double width_m, double height_m,
                                   double albedo) {
   // make_plane faces +Z in its frame: carry +Z to world -X (towards the head), plane x to
-  // world Y, plane y to world Z.
+  // world -Y (the head's right), plane y to world Z (a proper rotation: -Y x Z = -X).
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   Eigen::Matrix3d R;
   R << 0, 0, -1,  //
-      1, 0, 0,    //
+      -1, 0, 0,   //
       0, 1, 0;
   T.linear() = R;
   T.translation() = Eigen::Vector3d(distance_m, 0, 0);

@@ -82,20 +82,28 @@ class Renderer {
   void accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum) const;
   void finish(const std::vector<float>& sum, std::uint64_t noise_key, MonoImage& out) const;
 
-  // Ground truth of the current view, per camera pixel (row-major):
+  // Ground truth of the current view, per camera pixel (row-major). Computed on the first
+  // request after set_view() (the per-frame path does not need it).
   /// Camera-frame z of the visible surface, 0 where nothing is seen.
-  const std::vector<float>& depth_m() const { return depth_m_; }
+  const std::vector<float>& depth_m() const { return truth().depth_m; }
   /// Index into set_view()'s objects of the visible surface, -1 where nothing is seen.
-  const std::vector<std::int16_t>& object_index() const { return object_index_; }
+  const std::vector<std::int16_t>& object_index() const { return truth().object_index; }
   /// Continuous projector row (pixel centres at integers) of the visible surface point when
   /// the projector lights it (inside its coded rows, not shadowed, facing it); NaN otherwise.
-  const std::vector<float>& projector_row() const { return projector_row_; }
+  const std::vector<float>& projector_row() const { return truth().projector_row; }
   /// Code whose rows light the pixel (Eq. 1 layout), -1 when no coded row does.
-  const std::vector<std::int16_t>& code() const { return code_; }
+  const std::vector<std::int16_t>& code() const { return truth().code; }
 
  private:
   void prepare_triangles(const std::vector<RenderObject>& objects);
-  void compute_row(int y);
+  struct Truth {
+    bool valid = false;
+    std::vector<float> depth_m, projector_row;
+    std::vector<std::int16_t> object_index, code;
+  };
+  template <bool kWithTruth>
+  void compute_row(int y, Truth* truth);
+  const Truth& truth() const;
   template <typename ValueFn>
   void quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) const;
 
@@ -106,7 +114,9 @@ class Renderer {
   std::vector<std::int8_t> noise_bank_;  ///< N(0, 1) samples x 32, drawn once from noise_seed
   Eigen::Matrix3f R_projector_camera_;
   Eigen::Vector3f t_projector_camera_m_, projector_centre_camera_m_;
-  std::vector<float> ray_x_, ray_y_;  ///< normalised camera ray per column / row
+  std::vector<float> ray_x_, ray_y_;                   ///< normalised camera ray per column / row
+  std::vector<float> row_z_, row_u_, row_v_, row_qz_;  ///< scratch of compute_row
+  std::vector<float> row_nx_, row_ny_, row_nz_, row_albedo_;
   DepthBuffer camera_buffer_, projector_buffer_;
   // Per triangle of the current view (ids are cumulative over objects).
   std::vector<Eigen::Vector3f> normal_camera_;
@@ -116,9 +126,7 @@ class Renderer {
   // Per pixel, for shading: intensity = base + gain * bit.
   std::vector<float> base_dn_, gain_dn_;
   std::vector<std::uint16_t> gray_;
-  // Ground truth.
-  std::vector<float> depth_m_, projector_row_;
-  std::vector<std::int16_t> object_index_, code_;
+  mutable Truth truth_;  ///< filled lazily by truth()
 };
 
 /// The noise key of a frame: mixes the frame index so consecutive frames are independent.
