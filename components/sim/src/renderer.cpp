@@ -56,15 +56,17 @@ PinholeView make_view(const decode::LensModel& lens, double scale, double near_m
   return view;
 }
 
-/// Per pixel of a camera row: z from 1/z, and the projector coordinates (u, v) and depth qz of
-/// the point, with q = z (column_term rx + row_term) + t. Pixels with nothing (w = 0) get
-/// z = 0; points not in front of the projector get u = v = -1. No control flow, so the
-/// compiler vectorises it (a free function: inside the member it did not).
+/// Per pixel of a camera row: z from 1/z, the projector coordinates (u, v) and depth qz of
+/// the point and 1 / its distance to the projector centre, with q = z (column_term rx + row_term) +
+/// t. Pixels with nothing (w = 0) get z = 0; points not in front of the projector get u = v = -1.
+/// No control flow, so the compiler vectorises it (a free function: inside the member it did not).
 void project_row(int width, const float* __restrict inv_depth, const float* __restrict ray_x,
                  const Eigen::Vector3f& column_term, const Eigen::Vector3f& row_term,
                  const Eigen::Vector3f& t, float near, float fx, float fy, float cx, float cy,
-                 float* __restrict z_out, float* __restrict qz_out, float* __restrict u_out,
-                 float* __restrict v_out) {
+                 float ray_y, const Eigen::Vector3f& projector_centre, float* __restrict z_out,
+                 float* __restrict qz_out, float* __restrict u_out, float* __restrict v_out,
+                 float* __restrict inv_distance_out) {
+  const float c_x = projector_centre.x(), c_y = projector_centre.y(), c_z = projector_centre.z();
   const float ax = column_term.x(), ay = column_term.y(), az = column_term.z();
   const float bx = row_term.x(), by = row_term.y(), bz = row_term.z();
   const float tx = t.x(), ty = t.y(), tz = t.z();
@@ -81,31 +83,8 @@ void project_row(int width, const float* __restrict inv_depth, const float* __re
     qz_out[x] = qz;
     u_out[x] = front * (fx * qx * inv_qz + cx + 1.0f) - 1.0f;
     v_out[x] = front * (fy * qy * inv_qz + cy + 1.0f) - 1.0f;
-  }
-}
-
-/// Per pixel of a camera row at depth z with face normal n: base = albedo x ambient and
-/// gain = albedo x projector x cos(normal, direction to the projector) [x falloff], 0 when
-/// the face turns away from the projector. Normals facing away from the camera (back faces
-/// drawn with culling off) are flipped. Vectorised like project_row.
-void shade_row(int width, const float* __restrict ray_x, float ray_y, const float* __restrict z_in,
-               const float* __restrict nx, const float* __restrict ny, const float* __restrict nz,
-               const float* __restrict albedo, const Eigen::Vector3f& projector_centre,
-               float ambient, float projector_level, float falloff2, float* __restrict base_out,
-               float* __restrict gain_out) {
-  const float c_x = projector_centre.x(), c_y = projector_centre.y(), c_z = projector_centre.z();
-  const float use_falloff = static_cast<float>(falloff2 > 0);
-  for (int x = 0; x < width; ++x) {
-    const float z = z_in[x];
     const float dx = c_x - ray_x[x] * z, dy = c_y - ray_y * z, dz = c_z - z;
-    const float towards_camera = nx[x] * ray_x[x] + ny[x] * ray_y + nz[x];
-    const float sign = 1.0f - 2.0f * static_cast<float>(towards_camera > 0);
-    const float facing = sign * (nx[x] * dx + ny[x] * dy + nz[x] * dz);
-    const float distance2 = dx * dx + dy * dy + dz * dz + 1e-12f;
-    const float falloff = use_falloff * falloff2 / distance2 + (1.0f - use_falloff);
-    const float cosine = std::max(facing, 0.0f) / std::sqrt(distance2);
-    base_out[x] = albedo[x] * ambient;
-    gain_out[x] = albedo[x] * projector_level * cosine * falloff;
+    inv_distance_out[x] = 1.0f / std::sqrt(dx * dx + dy * dy + dz * dz + 1e-12f);
   }
 }
 
@@ -162,10 +141,7 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   row_u_.resize(g.camera.width);
   row_v_.resize(g.camera.width);
   row_qz_.resize(g.camera.width);
-  row_nx_.resize(g.camera.width);
-  row_ny_.resize(g.camera.width);
-  row_nz_.resize(g.camera.width);
-  row_albedo_.resize(g.camera.width);
+  row_inv_distance_.resize(g.camera.width);
   base_dn_.assign(pixels, 0.0f);
   gain_dn_.assign(pixels, 0.0f);
   gray_.assign(pixels, 0);
@@ -203,6 +179,7 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
   normal_camera_.clear();
   triangle_object_.clear();
   triangle_albedo_dn_.clear();
+  triangle_normal_dot_projector_.clear();
   for (std::size_t o = 0; o < objects.size(); ++o) {
     if (objects[o].mesh == nullptr)
       throw std::invalid_argument("sim::Renderer: object without mesh");
@@ -221,6 +198,8 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
           (scratch_camera_[t[1]] - a).cross(scratch_camera_[t[2]] - a).normalized());
       triangle_object_.push_back(static_cast<std::int16_t>(o));
       triangle_albedo_dn_.push_back(kFullScaleDn * static_cast<float>(objects[o].albedo));
+      triangle_normal_dot_projector_.push_back(
+          normal_camera_.back().dot(projector_centre_camera_m_));
     }
     rasterize(camera_view_, scratch_camera_, mesh.triangles, id_offset, config_.cull_back_faces,
               camera_buffer_);
@@ -244,6 +223,7 @@ void Renderer::compute_row(int y, Truth* truth) {
   std::uint16_t* gray_out = gray_.data() + row_start;
   const Eigen::Vector3f* normals = normal_camera_.data();
   const float* albedo_dn = triangle_albedo_dn_.data();
+  const float* normal_dot_projector = triangle_normal_dot_projector_.data();
   const std::int16_t* row_code = row_code_.data();
   const float* shadow_depth = projector_buffer_.inv_depth.data();
   const std::int32_t* shadow_id = projector_buffer_.triangle.data();
@@ -265,29 +245,15 @@ void Renderer::compute_row(int y, Truth* truth) {
   const Eigen::Vector3f t = t_projector_camera_m_;
 
   // Pass 1 (branch-free, vectorised): depth and projector coordinates of every pixel.
-  project_row(width, inv_depth, ray_x, column_term, row_term, t, near, fx, fy, cx, cy,
-              row_z_.data(), row_qz_.data(), row_u_.data(), row_v_.data());
+  project_row(width, inv_depth, ray_x, column_term, row_term, t, near, fx, fy, cx, cy, ray_y,
+              projector_centre_camera_m_, row_z_.data(), row_qz_.data(), row_u_.data(),
+              row_v_.data(), row_inv_distance_.data());
+  const float* inv_distance = row_inv_distance_.data();
   const float* z_row = row_z_.data();
   const float* qz_row = row_qz_.data();
   const float* u_row = row_u_.data();
   const float* v_row = row_v_.data();
-  // Pass 2: the visible triangle's normal and albedo per pixel (gather).
-  float* nx = row_nx_.data();
-  float* ny = row_ny_.data();
-  float* nz = row_nz_.data();
-  float* albedo = row_albedo_.data();
-  for (int x = 0; x < width; ++x) {
-    const std::int32_t id = ids[x];
-    const Eigen::Vector3f n = id < 0 ? Eigen::Vector3f::Zero() : normals[id];
-    nx[x] = n.x();
-    ny[x] = n.y();
-    nz[x] = n.z();
-    albedo[x] = id < 0 ? 0.0f : albedo_dn[id];
-  }
-  // Pass 3 (vectorised): ambient and projector light before the shadow test.
-  shade_row(width, ray_x, ray_y, z_row, nx, ny, nz, albedo, projector_centre_camera_m_, ambient,
-            projector_level, falloff2, base_out, gain_out);
-  // Pass 4: projector image bounds, coded rows and the shadow test.
+  // Pass 2: light, projector image bounds, coded rows and the shadow test.
   for (int x = 0; x < width; ++x) {
     const std::int32_t id = ids[x];
     gray_out[x] = 0;
@@ -297,7 +263,16 @@ void Renderer::compute_row(int y, Truth* truth) {
       truth->depth_m[row_start + x] = id < 0 ? 0.0f : z_row[x];
       truth->object_index[row_start + x] = id < 0 ? -1 : triangle_object_[id];
     }
-    if (!(gain_out[x] > 0)) continue;  // nothing seen, or facing away from the projector
+    base_out[x] = gain_out[x] = 0.0f;
+    if (id < 0) continue;
+    const float albedo = albedo_dn[id];
+    base_out[x] = albedo * ambient;
+    // cos(normal, direction to the projector): n.(c - p) with p = z ray, n.c per triangle.
+    const Eigen::Vector3f& n = normals[id];
+    const float n_ray = n.x() * ray_x[x] + n.y() * ray_y + n.z();
+    float facing = normal_dot_projector[id] - z_row[x] * n_ray;
+    if (n_ray > 0) facing = -facing;  // back face, drawn with culling off
+    if (!(facing > 0)) continue;      // turned away from the projector
     const float u = u_row[x], v = v_row[x];
     bool lit = u > -0.5f && u < u_max && v > -0.5f && v < v_max;  // also false behind it
     const int code = lit ? row_code[static_cast<int>(v + 0.5f)] : -1;
@@ -308,10 +283,10 @@ void Renderer::compute_row(int y, Truth* truth) {
       // Something nearer to the projector covers this point: projector shadow.
       lit = shadow_id[j] == id || !(w_seen > 0) || qz_row[x] * w_seen <= 1.0f + bias * w_seen;
     }
-    if (!lit || code < 0) {  // shadowed, outside the projector or an uncoded (dark) row
-      gain_out[x] = 0.0f;
-      continue;
-    }
+    if (!lit || code < 0) continue;  // shadowed, outside the projector or an uncoded (dark) row
+    float irradiance = projector_level * facing * inv_distance[x];
+    if (falloff2 > 0) irradiance *= falloff2 * inv_distance[x] * inv_distance[x];
+    gain_out[x] = albedo * irradiance;
     if constexpr (kWithTruth) {
       truth->projector_row[row_start + x] = v;
       truth->code[row_start + x] = static_cast<std::int16_t>(code);

@@ -116,12 +116,13 @@ class Renderer {
   Eigen::Vector3f t_projector_camera_m_, projector_centre_camera_m_;
   std::vector<float> ray_x_, ray_y_;                   ///< normalised camera ray per column / row
   std::vector<float> row_z_, row_u_, row_v_, row_qz_;  ///< scratch of compute_row
-  std::vector<float> row_nx_, row_ny_, row_nz_, row_albedo_;
+  std::vector<float> row_inv_distance_;
   DepthBuffer camera_buffer_, projector_buffer_;
   // Per triangle of the current view (ids are cumulative over objects).
   std::vector<Eigen::Vector3f> normal_camera_;
   std::vector<std::int16_t> triangle_object_;
-  std::vector<float> triangle_albedo_dn_;  ///< 255 x albedo of the triangle's object
+  std::vector<float> triangle_albedo_dn_;             ///< 255 x albedo of the triangle's object
+  std::vector<float> triangle_normal_dot_projector_;  ///< n . projector centre (camera frame)
   std::vector<Eigen::Vector3f> scratch_camera_, scratch_projector_;
   // Per pixel, for shading: intensity = base + gain * bit.
   std::vector<float> base_dn_, gain_dn_;
