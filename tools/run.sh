@@ -13,7 +13,9 @@ PACKAGES=(
   libopencv-dev libpcl-dev libmodbus-dev
   libzstd-dev liblz4-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  zlib1g-dev libpng-dev
   gnuplot-nox
+  clang libclang-rt-14-dev nodejs
 )
 BUILD_DIR=${AVS_BUILD_DIR:-build}
 JOBS=${AVS_JOBS:-$(nproc)}

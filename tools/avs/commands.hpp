@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -15,6 +16,22 @@ void add_components_command(CLI::App& app);
 void add_topic_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_demo_command(CLI::App& app);
+
+/// Subcommands in files of their own register themselves, so adding a command never edits
+/// main.cpp:  AVS_REGISTER_COMMAND(add_bag_command);  CLI11 lists commands in the order they
+/// are added; registered ones come after the built-in ones, sorted by function name.
+using CommandAdder = void (*)(CLI::App&);
+struct CommandRegistration {
+  CommandRegistration(const char* name, CommandAdder adder);
+};
+/// (name, adder) pairs of every registered command, sorted by name.
+std::vector<std::pair<std::string, CommandAdder>> registered_commands();
+
+#define AVS_REGISTER_COMMAND(adder)                                            \
+  namespace {                                                                   \
+  const ::avs::cli::CommandRegistration avs_command_registration_##adder{#adder, \
+                                                                         &adder}; \
+  }
 
 /// Runs `avs launch` on `file` (containers of `host` only, if set); returns the exit status.
 int launch_graph(const std::string& file, const std::vector<std::string>& words,

@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   avs::cli::add_components_command(app);
   avs::cli::add_topic_command(app);
   avs::cli::add_bench_command(app);
+  for (const auto& [name, adder] : avs::cli::registered_commands()) adder(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

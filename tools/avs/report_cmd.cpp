@@ -13,7 +13,7 @@
 
 namespace avs::cli {
 
-void add_report_command(CLI::App& app);
+namespace {
 
 void add_report_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
@@ -40,5 +40,9 @@ void add_report_command(CLI::App& app) {
 #endif
   });
 }
+
+}  // namespace
+
+AVS_REGISTER_COMMAND(add_report_command)
 
 }  // namespace avs::cli
