@@ -30,7 +30,7 @@ TEST(DecodeRoundTrip, OneCycleOfTheKenDecodesToTheTrueDepth) {
   decoder_config.geometry = config.renderer.geometry;
   decode::RollingDecoder decoder(decoder_config);
 
-  const HeadState head = look_at(config.head, Eigen::Vector3d(1.0, 0, 0));
+  const HeadState head = at_rest(look_at(config.head, Eigen::Vector3d(1.0, 0, 0)));
   decode::DecodeResult result;
   const int frames = 2 * config.renderer.geometry.layout.bit_count;
   std::vector<SimFrame> kept;  // the decoder may keep views into the images

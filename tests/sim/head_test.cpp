@@ -24,15 +24,82 @@ TEST(Head, ZeroAnglesLookAlongWorldXWithCameraOffsetA) {
   EXPECT_TRUE(T.translation().isApprox(Eigen::Vector3d(0.05, 0, 0)));
 }
 
-TEST(Head, PanTurnsLeftTiltLooksDownAndTheOffsetSwingsWithThem) {
+TEST(Head, PositivePanTurnsRightPositiveTiltLooksDownAndTheOffsetSwingsWithThem) {
+  // Servo convention (docs/servo.md section 1): positive pan turns the optical axis toward
+  // image +x (world -Y at home), positive tilt toward image +y (down).
   HeadConfig head;
   head.p_tilt_camera_m = Eigen::Vector3d(0.05, 0, 0);
   const Eigen::Isometry3d pan = T_world_camera(head, kPi / 2, 0);
-  EXPECT_TRUE(pan.linear().col(2).isApprox(Eigen::Vector3d::UnitY()));
-  EXPECT_TRUE(pan.translation().isApprox(Eigen::Vector3d(0, 0.05, 0)));
+  EXPECT_TRUE(pan.linear().col(2).isApprox(-Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(pan.translation().isApprox(Eigen::Vector3d(0, -0.05, 0)));
   const Eigen::Isometry3d tilt = T_world_camera(head, 0, 0.3);
   EXPECT_NEAR(tilt.linear().col(2).z(), -std::sin(0.3), 1e-12);
   EXPECT_NEAR(tilt.translation().z(), -0.05 * std::sin(0.3), 1e-12);
+  // The new axis direction, seen from the home camera frame, lies toward image +x / +y.
+  const Eigen::Matrix3d R_home = T_world_camera(head, 0, 0).linear();
+  EXPECT_GT((R_home.transpose() * T_world_camera(head, 0.1, 0).linear().col(2)).x(), 0.09);
+  EXPECT_GT((R_home.transpose() * T_world_camera(head, 0, 0.1).linear().col(2)).y(), 0.09);
+}
+
+TEST(Head, SmallPositivePanOrTiltMovesAStaticPointsImageTowardMinusXOrMinusY) {
+  // Eq. 15: d m_x / d q1 = -f cos q2, d m_y / d q2 = -f (here at q2 = 0, offsets zero).
+  HeadConfig head;
+  head.p_tilt_camera_m.setZero();
+  const Eigen::Vector3d p_world(1.0, 0.0, 0.0);
+  const auto image = [&](double pan, double tilt) {
+    const Eigen::Vector3d p = T_world_camera(head, pan, tilt).inverse() * p_world;
+    return Eigen::Vector2d(p.x() / p.z(), p.y() / p.z());  // normalised image coordinates
+  };
+  const double dq = 1e-4;
+  const Eigen::Vector2d d_pan = (image(dq, 0) - image(0, 0)) / dq;
+  const Eigen::Vector2d d_tilt = (image(0, dq) - image(0, 0)) / dq;
+  EXPECT_NEAR(d_pan.x(), -1.0, 1e-3);
+  EXPECT_NEAR(d_pan.y(), 0.0, 1e-6);
+  EXPECT_NEAR(d_tilt.x(), 0.0, 1e-6);
+  EXPECT_NEAR(d_tilt.y(), -1.0, 1e-3);
+  // At q2 = 0.5 the pan gain shrinks by cos q2 (Eq. 15's -f cos q2).
+  const Eigen::Vector3d p_below(std::cos(0.5), 0.0, -std::sin(0.5));
+  const auto image_below = [&](double pan) {
+    const Eigen::Vector3d p = T_world_camera(head, pan, 0.5).inverse() * p_below;
+    return p.x() / p.z();
+  };
+  EXPECT_NEAR((image_below(dq) - image_below(0)) / dq, -std::cos(0.5), 1e-3);
+}
+
+TEST(Head, RenderedImageOfACubeMovesTowardMinusXUnderPositivePan) {
+  SimulatorConfig config;
+  config.renderer.noise_sigma_dn = 0;
+  Scene scene;
+  SceneObject cube;
+  cube.name = "cube";
+  cube.mesh = std::make_shared<const geometry::Mesh>(geometry::make_builtin_model("cube"));
+  cube.trajectory =
+      std::make_shared<StaticTrajectory>(Eigen::Isometry3d(Eigen::Translation3d(1.0, 0.0, 0.0)));
+  scene.objects.push_back(cube);
+  Simulator sim(config, scene);
+  const auto centroid = [&](double pan, double tilt) {
+    (void)sim.render(0, HeadState{pan, tilt, 0, 0});
+    const Renderer& r = sim.renderer();
+    double sx = 0, sy = 0, n = 0;
+    for (int y = 0; y < r.height(); ++y) {
+      for (int x = 0; x < r.width(); ++x) {
+        if (r.object_index()[static_cast<std::size_t>(y) * r.width() + x] == 0) {
+          sx += x;
+          sy += y;
+          n += 1;
+        }
+      }
+    }
+    EXPECT_GT(n, 100);
+    return Eigen::Vector2d(sx / n, sy / n);
+  };
+  const Eigen::Vector2d home = centroid(0, 0);
+  const Eigen::Vector2d panned = centroid(0.05, 0);
+  const Eigen::Vector2d tilted = centroid(0, 0.05);
+  EXPECT_LT(panned.x() - home.x(), -20);  // about -f * 0.05 = -31 px
+  EXPECT_NEAR(panned.y(), home.y(), 2);
+  EXPECT_LT(tilted.y() - home.y(), -20);
+  EXPECT_NEAR(tilted.x(), home.x(), 2);
 }
 
 TEST(Head, LookAtCentresTheTargetInTheRenderedImage) {
@@ -47,7 +114,7 @@ TEST(Head, LookAtCentresTheTargetInTheRenderedImage) {
       std::make_shared<StaticTrajectory>(Eigen::Isometry3d(Eigen::Translation3d(target)));
   scene.objects.push_back(cube);
   Simulator sim(config, scene);
-  const HeadState head = look_at(config.head, target);
+  const HeadState head = at_rest(look_at(config.head, target));
   const SimFrame frame = sim.render(0, head);
   const Eigen::Vector3d p_camera = frame.truth.objects[0].T_camera_object.translation();
   EXPECT_NEAR(p_camera.x(), 0, 1e-9);

@@ -109,7 +109,7 @@ bench::Report run(const std::vector<std::string>& args) {
   Simulator moving(config, bench_scene(true));
   Simulator still(config, bench_scene(false));
   Simulator alone(config, bench_scene(true, false));
-  const HeadState head = look_at(config.head, Eigen::Vector3d(1.0, 0, 0));
+  const HeadState head = at_rest(look_at(config.head, Eigen::Vector3d(1.0, 0, 0)));
 
   std::vector<double> moving_ms, static_ms, alone_ms;
   std::size_t checksum = 0;

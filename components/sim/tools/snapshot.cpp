@@ -32,8 +32,8 @@ int main(int argc, char** argv) {
     const double t = argc > 3 ? std::atof(argv[3]) : 0.0;
     avs::sim::HeadState head;
     if (!file.scene.objects.empty()) {
-      head = avs::sim::look_at(file.config.head,
-                               file.scene.objects[0].trajectory->T_world_object(t).translation());
+      head = avs::sim::at_rest(avs::geometry::look_at(
+          file.config.head, file.scene.objects[0].trajectory->T_world_object(t).translation()));
     }
     avs::sim::Simulator sim(file.config, std::move(file.scene));
     const int frames = 2 * sim.config().renderer.geometry.layout.bit_count;
