@@ -1,0 +1,143 @@
+// Serialised (CDR) access to topics of any type this build knows, for tools that store and
+// replay samples without decoding them (`avs bag`): discovery of remote publications with
+// their offered QoS, readers handing out Cyclone's serdata as received, and writers that
+// publish CDR bytes as they are (no deserialise/serialise round trip either way).
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <dds/dds.h>
+#include <dds/ddsi/ddsi_serdata.h>
+
+#include "avs/msg/type_registry.hpp"
+#include "avs/runtime/dds.hpp"
+#include "avs/runtime/time.hpp"
+
+namespace avs::runtime::dds {
+
+/// The QoS policies an endpoint offers or requests, as far as recording and replay need them
+/// (the ones ROS 2 stores in rosbag2's `offered_qos_profiles`).
+struct EndpointQos {
+  bool reliable = true;
+  bool transient_local = false;
+  bool keep_all = false;
+  std::int32_t depth = 10;                   ///< KEEP_LAST depth (ignored with keep_all)
+  std::optional<Duration> deadline;          ///< nullopt: infinite
+  std::optional<Duration> lifespan;          ///< nullopt: infinite
+  bool liveliness_automatic = true;          ///< false: manual by participant/topic
+  std::optional<Duration> liveliness_lease;  ///< nullopt: infinite
+
+  /// From a Cyclone QoS object (policies it does not set keep their defaults above).
+  static EndpointQos from_dds(const dds_qos_t* qos);
+  /// A Cyclone QoS object with these policies.
+  Qos to_dds() const;
+  /// "reliable, volatile, keep_last 10" (for messages).
+  std::string describe() const;
+};
+
+/// One remote data writer, as seen on the DCPSPublication built-in topic.
+struct DiscoveredPublication {
+  std::string topic;                   ///< DDS name, e.g. "rt/chatter"
+  std::string type_name;               ///< DDS type name, e.g. "std_msgs::msg::dds_::String_"
+  std::array<std::uint8_t, 16> key{};  ///< the writer's GUID
+  EndpointQos qos;
+};
+
+/// Follows the DCPSPublication built-in topic: poll() returns the writers that appeared
+/// since the last call, skipping the participant's own and Cyclone's built-in (DCPS*) topics.
+class PublicationDiscovery {
+ public:
+  explicit PublicationDiscovery(const Participant& participant);
+  std::vector<DiscoveredPublication> poll();
+  /// The built-in reader (attach its status/read condition to a waitset to wake on news).
+  dds_entity_t reader() const { return reader_.get(); }
+
+ private:
+  Entity reader_;
+  std::array<std::uint8_t, 16> own_{};
+};
+
+/// Totals of samples a reader knows it did not get (cumulative since creation).
+struct ReaderLoss {
+  std::uint64_t lost = 0;      ///< DDS SAMPLE_LOST: gaps seen in the writer's sequence
+  std::uint64_t rejected = 0;  ///< DDS SAMPLE_REJECTED: no room in the reader history
+};
+
+/// A reader that hands out serialised samples (Cyclone serdata, one reference each).
+class RawReader {
+ public:
+  RawReader(const Participant& participant, const msg::TypeEntry& type,
+            const std::string& dds_topic, const EndpointQos& qos);
+
+  /// Takes up to `max` samples; for each valid one calls `fn(serdata, info)`. `fn` receives
+  /// a serdata reference it owns (keep it, or release it with ddsi_serdata_unref). Returns
+  /// the number of samples taken (invalid ones included).
+  template <class Fn>
+  int take(std::uint32_t max, Fn&& fn) {
+    constexpr std::uint32_t kBatch = 64;
+    int total = 0;
+    while (max > 0) {
+      ddsi_serdata* data[kBatch];
+      dds_sample_info_t infos[kBatch];
+      const std::uint32_t want = max < kBatch ? max : kBatch;
+      const dds_return_t n = dds_takecdr(reader_.get(), data, want, infos, DDS_ANY_STATE);
+      if (n < 0) check_dds(n, "take serialised samples from " + topic_);
+      if (n <= 0) break;
+      for (int i = 0; i < n; ++i) {
+        if (infos[i].valid_data) {
+          fn(data[i], infos[i]);
+        } else {
+          ddsi_serdata_unref(data[i]);
+        }
+      }
+      total += n;
+      max -= static_cast<std::uint32_t>(n);
+      if (static_cast<std::uint32_t>(n) < want) break;
+    }
+    return total;
+  }
+
+  dds_entity_t get() const { return reader_.get(); }
+  const std::string& topic() const { return topic_; }
+  ReaderLoss loss() const;
+  /// Writers this reader could not match because of incompatible QoS (cumulative).
+  std::uint32_t incompatible_writers() const;
+  std::uint32_t matched_writers() const;
+
+ private:
+  std::string topic_;
+  Entity topic_entity_;
+  Entity reader_;
+};
+
+/// A writer that publishes serialised samples (the 4-byte encapsulation header included),
+/// exactly as given: Cyclone's serdata is built from the bytes and written with
+/// dds_writecdr (source timestamp = time of writing).
+class RawWriter {
+ public:
+  RawWriter(const Participant& participant, const msg::TypeEntry& type,
+            const std::string& dds_topic, const EndpointQos& qos);
+  ~RawWriter();
+  RawWriter(const RawWriter&) = delete;
+  RawWriter& operator=(const RawWriter&) = delete;
+
+  /// Throws Error when Cyclone refuses the bytes (bad encapsulation header) or the write fails.
+  void write(std::span<const std::byte> cdr);
+  std::uint32_t matched_readers() const;
+  dds_entity_t get() const { return writer_.get(); }
+  const std::string& topic() const { return topic_; }
+
+ private:
+  std::string topic_;
+  Entity topic_entity_;
+  Entity writer_;
+  const ddsi_sertype* sertype_ = nullptr;  ///< one reference, released in the destructor
+};
+
+}  // namespace avs::runtime::dds

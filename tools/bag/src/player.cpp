@@ -1,0 +1,269 @@
+#include "avs/bag/player.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <set>
+#include <thread>
+
+#include "avs/bag/qos_yaml.hpp"
+#include "avs/introspection/type_database.hpp"
+#include "avs/mcap/reader.hpp"
+#include "avs/msg/type_registry.hpp"
+#include "avs/runtime/raw_topic.hpp"
+#include "avs/runtime/topic_name.hpp"
+#include "rosgraph_msgs.h"
+
+namespace avs::bag {
+
+namespace {
+
+using runtime::Error;
+namespace dds = runtime::dds;
+using SteadyClock = std::chrono::steady_clock;
+
+std::string ros_name(const std::string& name) {
+  if (name.rfind("rt/", 0) == 0) return runtime::from_dds_topic_name(name);
+  return runtime::resolve_topic_name("/", name);
+}
+
+struct ChannelPlan {
+  dds::RawWriter* writer = nullptr;  // null: not played
+  std::string published_as;
+};
+
+/// Paced publishing: maps bag log time to wall time, minus pauses, divided by the rate.
+class Pacer {
+ public:
+  Pacer(const PlayOptions& o, const PlayControl& c, mcap::Timestamp bag_start, double duration_s,
+        dds::Writer* clock_writer)
+      : options_(o),
+        control_(c),
+        bag_start_(bag_start),
+        duration_s_(duration_s),
+        clock_(clock_writer) {}
+
+  void begin_pass(int pass) {
+    pass_ = pass;
+    wall_start_ = SteadyClock::now();
+    paused_total_ = {};
+    last_clock_ = 0;
+  }
+
+  bool stopped() const { return control_.stop != nullptr && control_.stop->load(); }
+
+  /// Waits until `t` is due (publishing /clock and progress meanwhile); false when stopped.
+  bool wait_until(mcap::Timestamp t, std::uint64_t published) {
+    published_ = published;
+    for (;;) {
+      if (stopped()) return false;
+      const bool paused = control_.paused != nullptr && control_.paused->load();
+      const auto now = SteadyClock::now();
+      if (paused) {
+        const auto pause_start = now;
+        report(now, true);
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        paused_total_ += SteadyClock::now() - pause_start;
+        continue;
+      }
+      const mcap::Timestamp current = bag_time_at(now);
+      publish_clock(std::min(current, t));
+      report(now, false);
+      if (current >= t) return true;
+      const double wait_s = static_cast<double>(t - current) * 1e-9 / options_.rate;
+      const double step =
+          std::min({wait_s, 0.05, options_.clock ? options_.clock_period_s / options_.rate : 0.05});
+      if (step > 0.0005) {
+        std::this_thread::sleep_for(std::chrono::duration<double>(step));
+      } else if (step > 0) {
+        std::this_thread::yield();
+      }
+    }
+  }
+
+  void publish_clock(mcap::Timestamp t) {
+    if (clock_ == nullptr || t <= last_clock_) return;
+    if (t - last_clock_ < static_cast<mcap::Timestamp>(options_.clock_period_s * 1e9) &&
+        last_clock_ != 0) {
+      return;
+    }
+    force_clock(t);
+  }
+
+  /// /clock exactly at a message's time, before the message (sim-time graphs see the
+  /// sample no earlier than its time).
+  void force_clock(mcap::Timestamp t) {
+    if (clock_ == nullptr || t <= last_clock_) return;
+    rosgraph_msgs_msg_dds__Clock_ sample{};
+    runtime::to_ros_time(runtime::Time{static_cast<std::int64_t>(t)}, sample.clock);
+    clock_->write(&sample);
+    last_clock_ = t;
+  }
+
+  void report(SteadyClock::time_point now, bool paused) {
+    if (!control_.on_progress || now - last_report_ < std::chrono::milliseconds(100)) return;
+    last_report_ = now;
+    PlayProgress p;
+    p.bag_time_s = static_cast<double>(bag_time_at(now) - bag_start_) * 1e-9;
+    p.duration_s = duration_s_;
+    p.published = published_;
+    p.paused = paused;
+    p.pass = pass_;
+    control_.on_progress(p);
+  }
+
+ private:
+  mcap::Timestamp bag_time_at(SteadyClock::time_point now) const {
+    const double elapsed = std::chrono::duration<double>(now - wall_start_ - paused_total_).count();
+    return bag_start_ + static_cast<mcap::Timestamp>(std::max(0.0, elapsed) * options_.rate * 1e9);
+  }
+
+  const PlayOptions& options_;
+  const PlayControl& control_;
+  mcap::Timestamp bag_start_;
+  double duration_s_;
+  dds::Writer* clock_;
+  SteadyClock::time_point wall_start_{};
+  SteadyClock::duration paused_total_{};
+  SteadyClock::time_point last_report_{};
+  mcap::Timestamp last_clock_ = 0;
+  std::uint64_t published_ = 0;
+  int pass_ = 0;
+};
+
+}  // namespace
+
+PlayResult play(const PlayOptions& o, const PlayControl& control) {
+  if (!(o.rate > 0)) throw Error("avs bag play: --rate must be > 0");
+  mcap::Reader reader;
+  if (mcap::Status s = reader.open(o.file); !s.ok()) {
+    throw Error("avs bag play: " + o.file.string() + ": " + s.to_string());
+  }
+  bool truncated = false;
+  if (mcap::Status s = reader.read_summary(); !s.ok()) {
+    mcap::ScanResult scan;
+    if (mcap::Status s2 = reader.scan(scan, true); !s2.ok()) {
+      throw Error("avs bag play: " + o.file.string() + ": " + s2.to_string());
+    }
+    truncated = scan.truncated;
+    std::fprintf(
+        stderr,
+        "avs bag play: %s has no usable summary (%s); playing what a scan finds%s "
+        "(`avs bag repair` fixes the file)\n",
+        o.file.string().c_str(), s.to_string().c_str(),
+        scan.truncated ? (", up to offset " + std::to_string(scan.truncated_at)).c_str() : "");
+  }
+  const mcap::Summary& summary = reader.summary();
+  mcap::Timestamp start = 0, end = 0;
+  if (summary.statistics) {
+    start = summary.statistics->message_start_time;
+    end = summary.statistics->message_end_time;
+  } else if (!summary.chunk_indexes.empty()) {
+    start = ~mcap::Timestamp{0};
+    for (const auto& c : summary.chunk_indexes) {
+      if (c.message_start_time == 0 && c.message_end_time == 0) continue;
+      start = std::min(start, c.message_start_time);
+      end = std::max(end, c.message_end_time);
+    }
+    if (end == 0) start = 0;
+  }
+  const mcap::Timestamp bag_start =
+      start + static_cast<mcap::Timestamp>(std::max(0.0, o.start_offset_s) * 1e9);
+  const double duration_s = static_cast<double>(end - std::min(end, start)) * 1e-9;
+
+  std::set<std::string> wanted;
+  for (const auto& t : o.topics) wanted.insert(ros_name(t));
+  std::map<std::string, std::string> remaps;
+  for (const auto& [from, to] : o.remaps) remaps[ros_name(from)] = ros_name(to);
+
+  dds::Participant participant(dds::effective_domain(o.domain));
+  PlayResult result;
+  std::map<std::string, std::unique_ptr<dds::RawWriter>> writers;  // by published ROS name
+  std::map<mcap::ChannelId, ChannelPlan> plans;
+  std::set<std::string> read_topics;
+  for (const auto& [id, channel] : summary.channels) {
+    if (!wanted.empty() && wanted.count(channel.topic) == 0) continue;
+    auto skip = [&](const std::string& why) {
+      result.skipped.push_back(channel.topic + ": " + why);
+      std::fprintf(stderr, "avs bag play: NOT playing %s: %s\n", channel.topic.c_str(),
+                   why.c_str());
+    };
+    if (channel.message_encoding != "cdr") {
+      skip("message encoding '" + channel.message_encoding + "' (only cdr is played)");
+      continue;
+    }
+    auto schema = summary.schemas.find(channel.schema_id);
+    if (schema == summary.schemas.end()) {
+      skip("no schema (id " + std::to_string(channel.schema_id) + ")");
+      continue;
+    }
+    const std::string dds_type = introspection::dds_type_name(schema->second.name);
+    const msg::TypeEntry* type = msg::find_type(dds_type);
+    if (type == nullptr) {
+      skip("type " + schema->second.name + " is not known to this build");
+      continue;
+    }
+    std::vector<dds::EndpointQos> offered;
+    auto qos_it = channel.metadata.find("offered_qos_profiles");
+    try {
+      if (qos_it != channel.metadata.end()) offered = parse_offered_qos_yaml(qos_it->second);
+    } catch (const std::exception& e) {
+      skip(e.what());
+      continue;
+    }
+    std::string out = channel.topic;
+    if (auto r = remaps.find(channel.topic); r != remaps.end()) out = r->second;
+    auto& w = writers[out];
+    if (!w) {
+      w = std::make_unique<dds::RawWriter>(participant, *type, runtime::to_dds_topic_name(out),
+                                           replay_qos(offered));
+    }
+    plans[id] = {w.get(), out};
+    read_topics.insert(channel.topic);
+  }
+  if (plans.empty()) throw Error("avs bag play: " + o.file.string() + ": no topic to play");
+
+  std::unique_ptr<dds::Topic> clock_topic;
+  std::unique_ptr<dds::Writer> clock_writer;
+  if (o.clock) {
+    const runtime::QosProfile clock_qos = *runtime::QosProfile::named("clock");
+    clock_topic = std::make_unique<dds::Topic>(participant, &rosgraph_msgs_msg_dds__Clock__desc,
+                                               "rt/clock", clock_qos);
+    clock_writer = std::make_unique<dds::Writer>(participant, *clock_topic, clock_qos);
+  }
+  if (o.delay_s > 0) std::this_thread::sleep_for(std::chrono::duration<double>(o.delay_s));
+
+  Pacer pacer(o, control, bag_start, duration_s, clock_writer.get());
+  mcap::ReadOptions ro;
+  ro.start_time = bag_start;
+  ro.topics = read_topics;
+  ro.allow_truncated = truncated;
+  for (int pass = 0;; ++pass) {
+    pacer.begin_pass(pass);
+    std::string write_error;
+    const mcap::Status s = reader.read_messages(
+        [&](const mcap::MessageView& m) {
+          auto plan = plans.find(m.channel->id);
+          if (plan == plans.end()) return true;
+          if (!pacer.wait_until(m.log_time, result.published)) return false;
+          pacer.force_clock(m.log_time);
+          try {
+            plan->second.writer->write(m.data);
+          } catch (const std::exception& e) {
+            write_error = e.what();
+            return false;
+          }
+          ++result.published;
+          ++result.per_topic[plan->second.published_as];
+          return true;
+        },
+        ro);
+    if (!write_error.empty()) throw Error("avs bag play: " + write_error);
+    if (!s.ok()) throw Error("avs bag play: " + o.file.string() + ": " + s.to_string());
+    if (!o.loop || pacer.stopped()) break;
+  }
+  return result;
+}
+
+}  // namespace avs::bag
