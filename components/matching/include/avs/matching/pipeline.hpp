@@ -1,0 +1,98 @@
+// Depth image -> object pose, the whole per-frame path of the `matching` component without DDS:
+// target mask by a depth window (as the tracking component's phi_l < h < phi_h, Eq. 8), S-PCD
+// (section 6.3, Eq. 27), Tracker (initial alignment, ICP, loss), and an optional extrapolation
+// of the pose by the tracker's velocity to the image's stamp (the rolling depth map mixes the
+// last 2n frames, so the matched pose lags the newest frame; docs/matching.md measures it).
+#pragma once
+
+#include <cstddef>
+#include <deque>
+#include <string>
+
+#include "avs/geometry/mesh.hpp"
+#include "avs/matching/model_cloud.hpp"
+#include "avs/matching/pose_error.hpp"
+#include "avs/matching/scene_cloud.hpp"
+#include "avs/matching/tracker.hpp"
+
+namespace avs::matching {
+
+struct PipelineConfig {
+  /// The paper's sensor as decode::default_sensor_geometry() models it: 512 x 512,
+  /// f = 256 / tan(22.15 deg) = 628.8 px, principal point at the centre.
+  CameraIntrinsics camera{628.8F, 628.8F, 255.5F, 255.5F, 512, 512};
+  /// Target mask: pixels with depth_min_m <= z <= depth_max_m (SceneCloudConfig's min/max depth
+  /// are overwritten by these).
+  float depth_min_m = 0.3F;
+  float depth_max_m = 1.5F;
+  SceneCloudConfig scene;
+  TrackerConfig tracker;
+  /// The published pose is the matched pose moved forward by this much at the tracker's velocity
+  /// (0 = off). The matched pose describes the object some milliseconds before the newest frame.
+  double lag_compensation_s = 0.0;
+  /// The velocity is the mean motion over the valid tracked poses of the last this many
+  /// seconds (one frame-to-frame difference is too noisy to extrapolate by).
+  double velocity_window_s = 0.01;
+};
+
+/// Per-frame result of MatchingPipeline::process().
+struct PipelineOutput {
+  TrackResult track;
+  /// The pose to publish: track.T_camera_model, extrapolated by lag_compensation_s while
+  /// tracking with a velocity estimate.
+  Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+  bool has_pose = false;         ///< tracking: T_camera_model is the object's pose
+  bool lag_compensated = false;  ///< T_camera_model was extrapolated
+  std::size_t valid_pixels = 0;
+  std::size_t scene_points = 0;
+  double processing_ms = 0.0;  ///< wall-clock time of process()
+};
+
+class MatchingPipeline {
+ public:
+  MatchingPipeline(ModelCloud model, PipelineConfig config);
+
+  /// One depth image (metres, NaN or 0 invalid) taken at stamp_s.
+  PipelineOutput process(const DepthView& depth, double stamp_s);
+
+  void reset() { tracker_.reset(); }
+  [[nodiscard]] const Points& scene_points() const { return *scene_; }
+  [[nodiscard]] const ModelCloud& model() const { return model_; }
+  [[nodiscard]] const PipelineConfig& config() const { return config_; }
+  [[nodiscard]] const Tracker& tracker() const { return tracker_; }
+
+ private:
+  ModelCloud model_;
+  PipelineConfig config_;
+  SceneCloudBuilder builder_;
+  Tracker tracker_;
+  const Points* scene_;
+  Points empty_;
+  struct Stamped {
+    double stamp_s;
+    Eigen::Isometry3f T_camera_model;
+  };
+  std::deque<Stamped> history_;
+};
+
+/// A matching object: mesh, M-PCD size, i_number and symmetry (for error statistics only).
+struct ObjectModel {
+  std::string name;
+  std::string mesh_path;
+  geometry::Mesh mesh;
+  std::size_t model_points = 0;
+  std::size_t scene_points = 0;
+  Symmetry symmetry = Symmetry::none;
+};
+
+/// "ken", "cube", "cylinder": the shipped models/<name>.ply with the paper's sizes (section 7.2:
+/// 302/250 ken, 488/350 cube, 248/300 cylinder); anything else is a mesh path (PLY, STL, OBJ)
+/// with 300 model and 250 scene points and no symmetry. models_dir empty: $AVS_SOURCE_DIR/models,
+/// else the source tree's models/. Throws std::runtime_error naming the file when it cannot load.
+[[nodiscard]] ObjectModel load_object_model(const std::string& name_or_path,
+                                            const std::string& models_dir = "");
+
+/// Directory the built-in models are read from when models_dir is empty.
+[[nodiscard]] std::string default_models_dir();
+
+}  // namespace avs::matching

@@ -1,0 +1,134 @@
+#include "avs/matching/pipeline.hpp"
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+
+namespace avs::matching {
+namespace {
+
+SceneCloudConfig scene_config(const PipelineConfig& config, const ModelCloud& model) {
+  SceneCloudConfig scene = config.scene;
+  scene.min_depth_m = config.depth_min_m;
+  scene.max_depth_m = config.depth_max_m;
+  // Same density in both clouds (section 6.3): r defaults to the M-PCD's voxel side.
+  if (!(scene.voxel_size_m > 0.0F)) scene.voxel_size_m = model.voxel_size_m;
+  return scene;
+}
+
+/// pose moved forward by dt_s at the motion that took `older` (at t_older) to `newer` (at
+/// t_newer): constant linear and angular velocity in the camera frame.
+Eigen::Isometry3f extrapolate(const Eigen::Isometry3f& older, double t_older,
+                              const Eigen::Isometry3f& newer, double t_newer, double dt_s) {
+  if (!(t_newer > t_older)) return newer;
+  const double scale = dt_s / (t_newer - t_older);
+  const Eigen::Isometry3f delta = newer * older.inverse();  // older -> newer, camera frame
+  const Eigen::AngleAxisf rotation(delta.linear());
+  const Eigen::Matrix3f r =
+      Eigen::AngleAxisf(rotation.angle() * static_cast<float>(scale), rotation.axis())
+          .toRotationMatrix();
+  // Rotate about the object's origin, translate its origin at the mean velocity.
+  const Eigen::Vector3f v =
+      (newer.translation() - older.translation()) * static_cast<float>(scale);
+  Eigen::Isometry3f out = Eigen::Isometry3f::Identity();
+  out.linear() = r * newer.linear();
+  out.translation() = newer.translation() + v;
+  return out;
+}
+
+}  // namespace
+
+MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
+    : model_(std::move(model)),
+      config_(config),
+      builder_(scene_config(config_, model_)),
+      tracker_(model_, config_.tracker),
+      scene_(&empty_) {
+  if (!(config_.depth_min_m < config_.depth_max_m)) {
+    throw std::invalid_argument("MatchingPipeline: depth_min_m (" +
+                                std::to_string(config_.depth_min_m) +
+                                ") must be below depth_max_m (" +
+                                std::to_string(config_.depth_max_m) + ")");
+  }
+  if (config_.lag_compensation_s < 0.0 || config_.velocity_window_s <= 0.0) {
+    throw std::invalid_argument(
+        "MatchingPipeline: lag_compensation_s must be >= 0 and velocity_window_s > 0");
+  }
+}
+
+PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s) {
+  const auto start = std::chrono::steady_clock::now();
+  PipelineOutput out;
+  scene_ = &builder_.build(depth, {}, config_.camera);
+  out.valid_pixels = builder_.valid_pixels();
+  out.scene_points = scene_->size();
+  out.track = tracker_.update(*scene_, stamp_s);
+  out.has_pose = out.track.state == TrackingState::tracking;
+  out.T_camera_model = out.track.T_camera_model;
+
+  // Pose history for the velocity estimate: valid tracked poses only, within the window.
+  if (out.track.state != TrackingState::tracking || out.track.initialised_this_frame) {
+    history_.clear();
+  }
+  if (out.track.pose_valid) {
+    history_.push_back({stamp_s, out.track.T_camera_model});
+    while (history_.size() > 2 && stamp_s - history_[1].stamp_s >= config_.velocity_window_s) {
+      history_.pop_front();
+    }
+  }
+  if (config_.lag_compensation_s > 0.0 && out.has_pose && history_.size() >= 2) {
+    const Stamped& older = history_.front();
+    const Stamped& newer = history_.back();
+    out.T_camera_model = extrapolate(older.T_camera_model, older.stamp_s, newer.T_camera_model,
+                                     newer.stamp_s, config_.lag_compensation_s);
+    out.lag_compensated = true;
+  }
+  out.processing_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::string default_models_dir() {
+  if (const char* source = std::getenv("AVS_SOURCE_DIR"); source != nullptr && *source != 0) {
+    return std::string(source) + "/models";
+  }
+  return AVS_MATCHING_MODELS_DIR;
+}
+
+ObjectModel load_object_model(const std::string& name_or_path, const std::string& models_dir) {
+  ObjectModel object;
+  struct Preset {
+    const char* name;
+    std::size_t model_points, scene_points;
+    Symmetry symmetry;
+  };
+  // Section 7.2: M-PCD sizes 302 / 488 / 248 and i_number 250 / 350 / 300.
+  static constexpr Preset presets[] = {{"ken", 302, 250, Symmetry::none},
+                                       {"cube", 488, 350, Symmetry::cube},
+                                       {"cylinder", 248, 300, Symmetry::cylinder_z}};
+  object.name = name_or_path;
+  object.model_points = 300;
+  object.scene_points = 250;
+  object.mesh_path = name_or_path;
+  for (const Preset& preset : presets) {
+    if (name_or_path != preset.name) continue;
+    object.model_points = preset.model_points;
+    object.scene_points = preset.scene_points;
+    object.symmetry = preset.symmetry;
+    object.mesh_path = (models_dir.empty() ? default_models_dir() : models_dir) + "/" +
+                       preset.name + ".ply";
+  }
+  if (object.mesh_path == name_or_path) {
+    object.name = std::filesystem::path(name_or_path).stem().string();
+  }
+  if (!std::filesystem::exists(object.mesh_path)) {
+    throw std::runtime_error("matching model '" + name_or_path + "': no such file " +
+                             object.mesh_path +
+                             " (built-in names: ken, cube, cylinder; else a PLY/STL/OBJ path)");
+  }
+  object.mesh = geometry::load_mesh(object.mesh_path);
+  return object;
+}
+
+}  // namespace avs::matching
