@@ -6,23 +6,30 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-PACKAGES=(
+# What the demo needs (runtime, components, `avs`, report figures).
+DEMO_PACKAGES=(
   build-essential cmake pkg-config
   cyclonedds-dev cyclonedds-tools
   libeigen3-dev libyaml-cpp-dev libcli11-dev libnanoflann-dev
-  libopencv-dev libpcl-dev libmodbus-dev
-  libzstd-dev liblz4-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
-  zlib1g-dev libpng-dev
+  libmodbus-dev libzstd-dev liblz4-dev zlib1g-dev libpng-dev
   gnuplot-nox
+)
+# What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;
+# the MCAP fuzzer: clang; the independent MCAP reader: Node.js).
+TEST_PACKAGES=(
+  libopencv-dev libpcl-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev nodejs
 )
 BUILD_DIR=${AVS_BUILD_DIR:-build}
+# The demo builds only the `avs` program, without tests and benchmarks, in its own folder, so
+# that a fresh machine gets to the demo without installing PCL and OpenCV.
+DEMO_BUILD_DIR=${AVS_DEMO_BUILD_DIR:-build-demo}
 JOBS=${AVS_JOBS:-$(nproc)}
 
 install_missing() {
   local missing=()
-  for p in "${PACKAGES[@]}"; do
+  for p in "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ ${#missing[@]} -gt 0 ]; then
@@ -34,23 +41,26 @@ install_missing() {
   fi
 }
 
+# build DIR [cmake args...]: configures once, then builds (all targets, or AVS_TARGET).
 build() {
-  if [ ! -f "$BUILD_DIR/CMakeCache.txt" ]; then
-    cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release ${AVS_CMAKE_ARGS:-}
+  local dir=$1
+  shift
+  if [ ! -f "$dir/CMakeCache.txt" ]; then
+    cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" ${AVS_CMAKE_ARGS:-}
   fi
-  cmake --build "$BUILD_DIR" -j "$JOBS"
+  cmake --build "$dir" -j "$JOBS" ${AVS_TARGET:+--target "$AVS_TARGET"}
 }
 
 case "${1:-}" in
   demo)
-    install_missing
-    build
+    install_missing "${DEMO_PACKAGES[@]}"
+    AVS_TARGET=avs build "$DEMO_BUILD_DIR" -DAVS_BUILD_TESTS=OFF -DAVS_BUILD_BENCHMARKS=OFF
     shift
-    exec "$BUILD_DIR/tools/avs" demo "$@"
+    exec "$DEMO_BUILD_DIR/tools/avs" demo "$@"
     ;;
   test)
-    install_missing
-    build
+    install_missing "${DEMO_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
+    build "$BUILD_DIR"
     cd "$BUILD_DIR"
     exec ctest --output-on-failure -j "$JOBS" --timeout 600
     ;;

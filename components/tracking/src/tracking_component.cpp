@@ -4,6 +4,7 @@
 // tau = Kp J^-1 (m_d - m_g) - Kv q' (Eq. 16, image Jacobian of Eq. 15, full or simplified)
 // with the latest /head/joint_states -> /head/torque_command. `enabled: false` is the paper's
 // "no tracking" run: the head holds its pose (joint PD) whatever the image shows.
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -87,7 +88,8 @@ class TrackingComponent final : public runtime::Component {
                                "tests: write <name>.csv (one row per image) on deactivate")},
         .publishes = {runtime::port<msgs::avs_msgs::TargetObservation>("target", "/target"),
                       runtime::port<msgs::avs_msgs::JointTorqueCommand>(
-                          "torque_command", "/head/torque_command", keep_last_1)},
+                          "torque_command", "/head/torque_command", keep_last_1),
+                      runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing")},
         .subscribes = {
             runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
             runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states")}};
@@ -97,6 +99,7 @@ class TrackingComponent final : public runtime::Component {
       : Component(ctx),
         target_(ctx.publisher<msgs::avs_msgs::TargetObservation>("target")),
         command_(ctx.publisher<msgs::avs_msgs::JointTorqueCommand>("torque_command")),
+        timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
         tracker_(make_config(ctx)),
         enabled_(ctx.param<bool>("enabled")),
         report_dir_(ctx.param<std::string>("report_dir")) {
@@ -183,6 +186,7 @@ class TrackingComponent final : public runtime::Component {
       return;
     }
     ++images_;
+    const auto started = std::chrono::steady_clock::now();
     DepthImageView view;
     view.depth_m = reinterpret_cast<const float*>(image.data._buffer);
     view.width = static_cast<int>(image.width);
@@ -206,6 +210,7 @@ class TrackingComponent final : public runtime::Component {
       warned_no_joints_ = true;
     }
     publish_command(torque);
+    publish_timing(image, started);
     if (!report_dir_.empty()) {
       char line[256];
       std::snprintf(line, sizeof line, "%.6f,%d,%.9g,%.9g,%.9g,%.9g,%d,%.9g,%.9g\n",
@@ -230,6 +235,18 @@ class TrackingComponent final : public runtime::Component {
     target_.publish(std::move(msg));
   }
 
+  /// Wall-clock time of moments + servo law for this image (the "tracking" stage of reports).
+  void publish_timing(const msgs::sensor_msgs::Image& image,
+                      std::chrono::steady_clock::time_point started) {
+    auto msg = runtime::make_sample<msgs::avs_msgs::StageTiming>();
+    msg->header.stamp = image.header.stamp;
+    runtime::set_string(msg->stage, "tracking");
+    msg->processing_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started)
+            .count();
+    timing_.publish(std::move(msg));
+  }
+
   void publish_command(const Eigen::Vector2d& torque) {
     auto msg = runtime::make_sample<msgs::avs_msgs::JointTorqueCommand>();
     // Stamped when computed: servo_drive's command timeout measures from here.
@@ -245,6 +262,7 @@ class TrackingComponent final : public runtime::Component {
 
   runtime::Publisher<msgs::avs_msgs::TargetObservation> target_;
   runtime::Publisher<msgs::avs_msgs::JointTorqueCommand> command_;
+  runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
   Tracker tracker_;
   bool enabled_;
   std::string report_dir_;

@@ -1,0 +1,283 @@
+// run_recorder (see run_recorder_component.hpp).
+#include "avs/run_recorder/run_recorder_component.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include "avs/geometry/builtin_models.hpp"
+#include "avs/geometry/mesh.hpp"
+#include "avs/matching/model_cloud.hpp"
+#include "avs/runtime/sample.hpp"
+#include "avs/runtime/time.hpp"
+
+namespace avs::run_recorder {
+
+using runtime::ParamSpec;
+
+namespace {
+
+std::int64_t stamp_ns(const msgs::builtin_interfaces::Time& t) {
+  return runtime::from_ros_time(t).ns;
+}
+
+report::Pose to_pose(const msgs::geometry_msgs::Pose& p) {
+  report::Pose out;
+  out.p_world_m = {p.position.x, p.position.y, p.position.z};
+  out.q_world =
+      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
+          .normalized();
+  return out;
+}
+
+report::MatchState to_match_state(std::uint8_t state) {
+  switch (state) {
+    case avs_msgs_msg_dds__MatchResult_Constants_STATE_INITIALISING:
+      return report::MatchState::init;
+    case avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING:
+      return report::MatchState::tracking;
+    case avs_msgs_msg_dds__MatchResult_Constants_STATE_LOST:
+      return report::MatchState::lost;
+    default:
+      return report::MatchState::none;
+  }
+}
+
+geometry::Mesh load_model(const std::string& model) {
+  for (const auto& name : geometry::builtin_model_names()) {
+    if (name == model) return geometry::make_builtin_model(model);
+  }
+  return geometry::load_mesh(model);
+}
+
+/// x, y, z (FLOAT32) of a PointCloud2; throws for a layout without them.
+std::vector<Eigen::Vector3d> cloud_points(const msgs::sensor_msgs::PointCloud2& cloud) {
+  int offset[3] = {-1, -1, -1};
+  const char* names[3] = {"x", "y", "z"};
+  for (std::uint32_t i = 0; i < cloud.fields._length; ++i) {
+    const auto& f = cloud.fields._buffer[i];
+    for (int a = 0; a < 3; ++a) {
+      if (runtime::get_string(f.name) == names[a] && f.datatype == 7 /* FLOAT32 */) {
+        offset[a] = static_cast<int>(f.offset);
+      }
+    }
+  }
+  if (offset[0] < 0 || offset[1] < 0 || offset[2] < 0 || cloud.is_bigendian) {
+    throw std::runtime_error("PointCloud2 without little-endian FLOAT32 x, y, z fields");
+  }
+  const std::size_t count = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (cloud.point_step < 12 || count * cloud.point_step > cloud.data._length) {
+    throw std::runtime_error("PointCloud2 data shorter than width x height x point_step");
+  }
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint8_t* p = cloud.data._buffer + i * cloud.point_step;
+    float xyz[3];
+    for (int a = 0; a < 3; ++a) std::memcpy(&xyz[a], p + offset[a], 4);
+    if (std::isfinite(xyz[0]) && std::isfinite(xyz[1]) && std::isfinite(xyz[2])) {
+      points.emplace_back(xyz[0], xyz[1], xyz[2]);
+    }
+  }
+  return points;
+}
+
+}  // namespace
+
+runtime::ComponentSpec RunRecorderComponent::spec() {
+  runtime::QosProfile deep;
+  deep.depth = 100;
+  return {
+      .type = "run_recorder",
+      .description =
+          "writes a run folder (frames.csv, meta.csv, snapshots; docs/report.md) "
+          "from ground truth, depth, target, match and timing topics",
+      .parameters =
+          {ParamSpec::string("dir", "", "run folder to write (required)"),
+           ParamSpec::string("scenario", "demo", "scenario name written to meta.csv"),
+           ParamSpec::string("object", "ken", "target model name written to meta.csv"),
+           ParamSpec::string("symmetry", "none",
+                             "symmetry for the orientation error: none, cube, cylinder_x|y|z"),
+           ParamSpec::string("notes", "", "free text shown in the report"),
+           ParamSpec::string("model", "",
+                             "mesh drawn over the scene in the cloud snapshots (built-in name or "
+                             "file); empty: `object`"),
+           ParamSpec::real("fx_px", 628.8, 1.0, 1e5, "px", "camera focal length x (in-view test)"),
+           ParamSpec::real("fy_px", 628.8, 1.0, 1e5, "px", "camera focal length y"),
+           ParamSpec::real("cx_px", 255.5, -1e4, 1e4, "px", "principal point x"),
+           ParamSpec::real("cy_px", 255.5, -1e4, 1e4, "px", "principal point y"),
+           ParamSpec::integer("width", 512, 1, 100000, "px", "image width"),
+           ParamSpec::integer("height", 512, 1, 100000, "px", "image height"),
+           ParamSpec::real("depth_snapshot_time_s", 1.0, 0.0, 1e9, "s",
+                           "the first depth image at or after this time is kept (Figure 9)"),
+           ParamSpec::real_list("cloud_snapshot_times_s", {0.5, 1.0, 1.5}, "s",
+                                "scene/model snapshots (Figure 14) at these times")},
+      .publishes = {},
+      .subscribes = {
+          runtime::port<msgs::avs_msgs::GroundTruth>("ground_truth", "/sim/ground_truth", deep),
+          runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
+          runtime::port<msgs::avs_msgs::TargetObservation>("target", "/target", deep),
+          runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match", deep),
+          runtime::port<msgs::geometry_msgs::PoseStamped>("pose_world", "/object/pose_world", deep),
+          runtime::port<msgs::geometry_msgs::PoseStamped>("pose", "/object/pose", deep),
+          runtime::port<msgs::sensor_msgs::PointCloud2>("scene_points", "/object/scene_points"),
+          runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing", deep)}};
+}
+
+RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Component(ctx) {
+  const auto dir = ctx.param<std::string>("dir");
+  if (dir.empty()) throw std::invalid_argument("parameter 'dir' (the run folder) is required");
+  report::RunInfo info;
+  info.scenario = ctx.param<std::string>("scenario");
+  info.object = ctx.param<std::string>("object");
+  info.symmetry = ctx.param<std::string>("symmetry");
+  info.notes = ctx.param<std::string>("notes");
+  std::filesystem::create_directories(dir);
+  recorder_ = std::make_unique<report::RunRecorder>(dir, info);
+
+  CameraModel camera;
+  camera.fx_px = ctx.param<double>("fx_px");
+  camera.fy_px = ctx.param<double>("fy_px");
+  camera.cx_px = ctx.param<double>("cx_px");
+  camera.cy_px = ctx.param<double>("cy_px");
+  camera.width = ctx.param<int>("width");
+  camera.height = ctx.param<int>("height");
+  assembler_ = std::make_unique<FrameAssembler>(
+      camera, [this](const report::FrameRow& row) { recorder_->write_frame(row); });
+  depth_snapshot_time_s_ = ctx.param<double>("depth_snapshot_time_s");
+  cloud_times_s_ = ctx.param<std::vector<double>>("cloud_snapshot_times_s");
+  std::sort(cloud_times_s_.begin(), cloud_times_s_.end());
+
+  std::string model = ctx.param<std::string>("model");
+  if (model.empty()) model = info.object;
+  if (!cloud_times_s_.empty()) {
+    try {
+      matching::ModelCloudConfig config;
+      config.target_points = 400;
+      const auto cloud = matching::make_model_cloud(load_model(model), config);
+      for (const auto& p : cloud.points_m) model_points_m_.push_back(p.cast<double>());
+    } catch (const std::exception& e) {
+      log().warn("no model cloud for the snapshots (", model, "): ", e.what());
+    }
+  }
+
+  ctx.subscribe<msgs::avs_msgs::GroundTruth>(
+      "ground_truth", [this](runtime::SamplePtr<msgs::avs_msgs::GroundTruth> m) {
+        Truth truth;
+        truth.world = to_pose(m->pose_world);
+        truth.p_camera_m = {m->pose_camera.position.x, m->pose_camera.position.y,
+                            m->pose_camera.position.z};
+        truth.pan_rad = m->pan_rad;
+        truth.tilt_rad = m->tilt_rad;
+        assembler_->on_truth(stamp_ns(m->header.stamp), truth);
+        ++progress_.frames;
+      });
+  ctx.subscribe<msgs::sensor_msgs::Image>(
+      "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
+  ctx.subscribe<msgs::avs_msgs::TargetObservation>(
+      "target", [this](runtime::SamplePtr<msgs::avs_msgs::TargetObservation> m) {
+        assembler_->on_target(stamp_ns(m->header.stamp), m->valid, m->centroid_x_px,
+                              m->centroid_y_px);
+        if (m->valid) ++progress_.targets_valid;
+      });
+  ctx.subscribe<msgs::avs_msgs::MatchResult>(
+      "match", [this](runtime::SamplePtr<msgs::avs_msgs::MatchResult> m) {
+        assembler_->on_match(stamp_ns(m->header.stamp), to_match_state(m->state),
+                             static_cast<int>(m->scene_points), m->processing_time_ms);
+      });
+  ctx.subscribe<msgs::geometry_msgs::PoseStamped>(
+      "pose_world", [this](runtime::SamplePtr<msgs::geometry_msgs::PoseStamped> m) {
+        assembler_->on_pose_world(stamp_ns(m->header.stamp), to_pose(m->pose));
+        ++progress_.poses;
+      });
+  ctx.subscribe<msgs::geometry_msgs::PoseStamped>(
+      "pose",
+      [this](runtime::SamplePtr<msgs::geometry_msgs::PoseStamped> m) { on_pose_camera(*m); });
+  ctx.subscribe<msgs::sensor_msgs::PointCloud2>(
+      "scene_points",
+      [this](runtime::SamplePtr<msgs::sensor_msgs::PointCloud2> m) { on_scene_points(*m); });
+  ctx.subscribe<msgs::avs_msgs::StageTiming>(
+      "timing", [this](runtime::SamplePtr<msgs::avs_msgs::StageTiming> m) {
+        assembler_->on_timing(stamp_ns(m->header.stamp), std::string(runtime::get_string(m->stage)),
+                              m->processing_ms);
+      });
+}
+
+RunRecorderComponent::~RunRecorderComponent() {
+  if (!finished_) {
+    try {
+      assembler_->flush();
+      recorder_->flush();
+    } catch (...) {  // a destructor must not throw; on_deactivate reports errors
+    }
+  }
+}
+
+void RunRecorderComponent::on_deactivate() {
+  assembler_->flush();
+  recorder_->flush();
+  finished_ = true;
+  const auto& s = assembler_->stats();
+  log().info("run folder ", recorder_->dir().string(), ": ", s.rows_written, " depth updates, ",
+             s.poses, " with a pose");
+  if (s.rows_without_truth > 0) {
+    log().warn(s.rows_without_truth,
+               " depth updates had no ground truth with their stamp and are not in frames.csv");
+  }
+}
+
+void RunRecorderComponent::on_depth(const msgs::sensor_msgs::Image& image) {
+  const std::int64_t stamp = stamp_ns(image.header.stamp);
+  assembler_->on_depth(stamp);
+  ++progress_.depth_updates;
+  progress_.last_stamp_ns = stamp;
+  const double t_s = static_cast<double>(stamp) * 1e-9;
+  if (depth_snapshot_taken_ || t_s < depth_snapshot_time_s_) return;
+  if (runtime::get_string(image.encoding) != "32FC1" || image.step != image.width * 4 ||
+      static_cast<std::uint64_t>(image.step) * image.height > image.data._length) {
+    log().warn("depth snapshot skipped: expected packed 32FC1, got '",
+               runtime::get_string(image.encoding), "'");
+    depth_snapshot_taken_ = true;
+    return;
+  }
+  recorder_->write_depth_snapshot(
+      t_s, static_cast<int>(image.width), static_cast<int>(image.height),
+      std::span<const float>(reinterpret_cast<const float*>(image.data._buffer),
+                             static_cast<std::size_t>(image.width) * image.height));
+  depth_snapshot_taken_ = true;
+}
+
+void RunRecorderComponent::on_pose_camera(const msgs::geometry_msgs::PoseStamped& pose) {
+  const report::Pose p = to_pose(pose.pose);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = p.q_world.toRotationMatrix();  // camera frame here, despite the field's name
+  T.translation() = p.p_world_m;
+  last_pose_camera_ = {stamp_ns(pose.header.stamp), T};
+}
+
+void RunRecorderComponent::on_scene_points(const msgs::sensor_msgs::PointCloud2& cloud) {
+  if (next_cloud_ >= cloud_times_s_.size()) return;
+  const std::int64_t stamp = stamp_ns(cloud.header.stamp);
+  if (static_cast<double>(stamp) * 1e-9 < cloud_times_s_[next_cloud_]) return;
+  // The model at the pose estimated from this very cloud (published before the cloud).
+  if (!last_pose_camera_ || last_pose_camera_->first != stamp) return;
+  std::vector<Eigen::Vector3d> scene;
+  try {
+    scene = cloud_points(cloud);
+  } catch (const std::exception& e) {
+    log().warn("cloud snapshot skipped: ", e.what());
+    next_cloud_ = cloud_times_s_.size();
+    return;
+  }
+  std::vector<Eigen::Vector3d> model;
+  model.reserve(model_points_m_.size());
+  for (const auto& p : model_points_m_) model.push_back(last_pose_camera_->second * p);
+  if (scene.empty() && model.empty()) return;
+  recorder_->write_cloud_snapshot(static_cast<double>(stamp) * 1e-9, scene, model);
+  ++next_cloud_;
+}
+
+AVS_REGISTER_COMPONENT(RunRecorderComponent);
+
+}  // namespace avs::run_recorder
