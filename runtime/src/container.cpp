@@ -279,10 +279,22 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
         {"callbacks", std::to_string(stats.callbacks)},
         {"callback_ms_mean", std::to_string(stats.callbacks ? stats.total_ms / static_cast<double>(stats.callbacks) : 0.0)},
         {"callback_ms_max", std::to_string(stats.max_ms)}};
-    resize_sequence(status.values, 3);
+    std::vector<std::pair<std::string, std::string>> extra;
+    if (host.component) {
+      try {
+        extra = host.component->diagnostic_values();
+      } catch (const std::exception& e) {
+        extra = {{"diagnostic_values_error", e.what()}};
+      }
+    }
+    resize_sequence(status.values, static_cast<std::uint32_t>(3 + extra.size()));
     for (std::size_t k = 0; k < 3; ++k) {
       set_string(status.values._buffer[k].key, values[k].first);
       set_string(status.values._buffer[k].value, values[k].second);
+    }
+    for (std::size_t k = 0; k < extra.size(); ++k) {
+      set_string(status.values._buffer[3 + k].key, extra[k].first);
+      set_string(status.values._buffer[3 + k].value, extra[k].second);
     }
   }
   writer.write(array.get());

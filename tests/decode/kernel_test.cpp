@@ -1,4 +1,6 @@
-// The scalar, SSE2 and AVX2 pair updates give bit-identical Gray words, flags and depths.
+// The scalar, SSE2 and AVX2 pair updates give bit-identical Gray words, flags and depths, with
+// per-pixel rays and with separable rays (a camera without distortion).
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -14,6 +16,8 @@ namespace {
 TEST(PairKernel, AllInstructionSetsAgree) {
   const SensorGeometry g = default_sensor_geometry();
   const DepthTable table(g);
+  ASSERT_NE(table.column_ray_x(), nullptr) << "no distortion: separable rays";
+  ASSERT_NE(table.row_ray_y(), nullptr);
   const int width = g.camera.width, height = g.camera.height, pixels = width * height;
   std::mt19937 random(3);
   std::uniform_int_distribution<int> byte(0, 255), word(0, 511);
@@ -28,7 +32,10 @@ TEST(PairKernel, AllInstructionSetsAgree) {
   for (int bit_position : {8, 4, 0}) {
     std::vector<std::vector<std::uint16_t>> grays, valids;
     std::vector<std::vector<float>> depths;
-    for (KernelIsa isa : {KernelIsa::kScalar, KernelIsa::kSse2, KernelIsa::kAvx2}) {
+    for (int variant = 0; variant < 6; ++variant) {
+      const KernelIsa isa =
+          std::array{KernelIsa::kScalar, KernelIsa::kSse2, KernelIsa::kAvx2}[variant % 3];
+      const bool separable = variant >= 3;
       if (isa == KernelIsa::kAvx2 && best_kernel_isa() != KernelIsa::kAvx2) continue;
       grays.push_back(gray);
       valids.push_back(valid);
@@ -49,6 +56,10 @@ TEST(PairKernel, AllInstructionSetsAgree) {
       a.depth_m = depths.back().data();
       a.ray_x = table.ray_x();
       a.ray_y = table.ray_y();
+      if (separable) {
+        a.column_ray_x = table.column_ray_x();
+        a.row_ray_y = table.row_ray_y();
+      }
       a.planes = table.planes();
       a.invalid_index = table.invalid_index();
       a.min_depth_m = 0.05f;
@@ -76,6 +87,14 @@ TEST(PairKernel, AllInstructionSetsAgree) {
       }
     }
   }
+}
+
+TEST(PairKernel, DistortedCameraRaysAreNotSeparable) {
+  SensorGeometry g = default_sensor_geometry();
+  g.camera.k1 = -0.1;
+  const DepthTable table(g);
+  EXPECT_EQ(table.column_ray_x(), nullptr);
+  EXPECT_EQ(table.row_ray_y(), nullptr);
 }
 
 }  // namespace

@@ -212,6 +212,36 @@ TEST(RollingDecoder, AfterDisorderTheMapRecoversWithCorrectCodes) {
   EXPECT_GT(count_valid(r.depth_m), 200000);
 }
 
+TEST(RollingDecoder, DepthIntoACallersBufferEqualsItsOwn) {
+  // push_frame(frame, depth_out) (the decode component writes straight into its message).
+  const DecoderConfig config;
+  const auto scene = render_plane(config.geometry, scene_config(61));
+  RollingDecoder own(config);
+  RollingDecoder external(config);
+  std::vector<float> out(static_cast<std::size_t>(scene.width) * scene.height, 0.0f);
+  int compared = 0;
+  for (int cycle = 0; cycle < 2; ++cycle) {
+    for (int k = 0; k < kBits; ++k) {
+      for (Polarity polarity : {Polarity::kPositive, Polarity::kNegative}) {
+        const PatternFrame frame = scene.frame(k, polarity, cycle);
+        const DecodeResult a = own.push_frame(frame);
+        std::fill(out.begin(), out.end(), 0.0f);
+        const DecodeResult b = external.push_frame(frame, out);
+        ASSERT_EQ(a.depth_updated, b.depth_updated);
+        if (!b.depth_updated) continue;
+        ASSERT_EQ(b.depth_m.data(), out.data());
+        EXPECT_EQ(count_differences(a.depth_m, out), 0) << "cycle " << cycle << " bit " << k;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 2 * kBits);
+  EXPECT_GT(count_valid(out), scene.width * scene.height / 2);
+  std::vector<float> wrong_size(10);
+  EXPECT_THROW(external.push_frame(scene.frame(0, Polarity::kNegative, 5), wrong_size),
+               std::invalid_argument);
+}
+
 TEST(RollingDecoder, RejectsFramesThatDoNotFit) {
   const DecoderConfig config;
   RollingDecoder decoder(config);

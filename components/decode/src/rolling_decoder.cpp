@@ -103,6 +103,19 @@ bool RollingDecoder::accept_sequence(std::int64_t sequence) {
 }
 
 DecodeResult RollingDecoder::push_frame(const PatternFrame& frame) {
+  return push_frame_to(frame, depth_m_.data());
+}
+
+DecodeResult RollingDecoder::push_frame(const PatternFrame& frame, std::span<float> depth_out) {
+  if (depth_out.size() != depth_m_.size()) {
+    throw std::invalid_argument("rolling decoder: depth output holds " +
+                                std::to_string(depth_out.size()) + " floats, expected " +
+                                std::to_string(depth_m_.size()));
+  }
+  return push_frame_to(frame, depth_out.data());
+}
+
+DecodeResult RollingDecoder::push_frame_to(const PatternFrame& frame, float* depth_out) {
   ++stats_.frames_received;
   check_bit(frame.bit_index, bit_count_);
   check_image(frame.image, width_, height_, "frame");
@@ -126,7 +139,7 @@ DecodeResult RollingDecoder::push_frame(const PatternFrame& frame) {
   pending_positive_sequence_ = -1;
   const ImageView8 positive{pending_positive_.data(), width_, height_, width_};
   return apply_pair(positive, frame.image, frame.bit_index,
-                    frame.cycle * bit_count_ + frame.bit_index);
+                    frame.cycle * bit_count_ + frame.bit_index, depth_out);
 }
 
 DecodeResult RollingDecoder::push_pair(const ImageView8& positive, const ImageView8& negative,
@@ -143,7 +156,7 @@ DecodeResult RollingDecoder::push_pair(const ImageView8& positive, const ImageVi
   }
   accept_sequence(sequence + 1);
   pending_positive_sequence_ = -1;
-  return apply_pair(positive, negative, bit_index, cycle * bit_count_ + bit_index);
+  return apply_pair(positive, negative, bit_index, cycle * bit_count_ + bit_index, depth_m_.data());
 }
 
 std::uint16_t RollingDecoder::fresh_mask() const {
@@ -158,7 +171,7 @@ std::uint16_t RollingDecoder::fresh_mask() const {
 }
 
 DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageView8& negative,
-                                        int bit_index, std::int64_t pair_index) {
+                                        int bit_index, std::int64_t pair_index, float* depth_out) {
   pair_of_bit_[bit_index] = pair_index;
   newest_pair_cycle_ = pair_index / bit_count_;
   newest_pair_bit_ = bit_index;
@@ -181,9 +194,11 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
   args.full_mask = full;
   const bool table_path = config_.triangulation == TriangulationMethod::kRayPlaneTable;
   if (all_fresh && table_path) {
-    args.depth_m = depth_m_.data();
+    args.depth_m = depth_out;
     args.ray_x = table_.ray_x();
     args.ray_y = table_.ray_y();
+    args.column_ray_x = table_.column_ray_x();
+    args.row_ray_y = table_.row_ray_y();
     args.planes = table_.planes();
     args.invalid_index = table_.invalid_index();
     args.min_depth_m = config_.min_depth_m;
@@ -191,19 +206,22 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
   }
   detail::update_pair(args);
 
+  const std::size_t pixels = depth_m_.size();
   if (!all_fresh) {
-    std::fill(depth_m_.begin(), depth_m_.end(), kNan);  // a bit of the window is missing
+    std::fill_n(depth_out, pixels, kNan);  // a bit of the window is missing
   } else if (!table_path) {
     const int code_count = config_.geometry.layout.code_count;
-    for (std::size_t i = 0; i < depth_m_.size(); ++i) {
+    for (std::size_t i = 0; i < pixels; ++i) {
       const int code = static_cast<int>(gray_to_binary(gray_[i]));
       float z = kNan;
       if (valid_[i] == full && code < code_count) z = reference_.depth(static_cast<int>(i), code);
-      depth_m_[i] = in_range(z, config_) ? z : kNan;
+      depth_out[i] = in_range(z, config_) ? z : kNan;
     }
   }
-  if (config_.compute_point_map) fill_point_map();
-  return make_result(true);
+  if (config_.compute_point_map && depth_out == depth_m_.data()) fill_point_map();
+  DecodeResult result = make_result(true);
+  result.depth_m = std::span<const float>(depth_out, pixels);
+  return result;
 }
 
 void RollingDecoder::fill_point_map() {

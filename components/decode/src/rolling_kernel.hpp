@@ -23,7 +23,11 @@ struct PairUpdateArgs {
   float* depth_m = nullptr;
   const float* ray_x = nullptr;
   const float* ray_y = nullptr;
-  const float* planes = nullptr;  ///< (a, b, c, 0) per binary code, NaN for invalid codes
+  /// Optional, both or neither: separable rays (DepthTable::column_ray_x / row_ray_y), used
+  /// instead of ray_x / ray_y when set; same values, so bit-identical results.
+  const float* column_ray_x = nullptr;  ///< width floats
+  const float* row_ray_y = nullptr;     ///< height floats
+  const float* planes = nullptr;        ///< (a, b, c, 0) per binary code, NaN for invalid codes
   int invalid_index = 0;
   float min_depth_m = 0;
   float max_depth_m = 0;

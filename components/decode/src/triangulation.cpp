@@ -46,6 +46,26 @@ DepthTable::DepthTable(const SensorGeometry& g) {
     }
   }
 
+  // Separable? (bitwise: the fast kernel then gives exactly the per-pixel result.)
+  bool separable = true;
+  for (int v = 0; v < height_ && separable; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * width_;
+    for (int u = 0; u < width_; ++u) {
+      if (ray_x_[row + u] != ray_x_[static_cast<std::size_t>(u)] ||
+          ray_y_[row + u] != ray_y_[row]) {
+        separable = false;
+        break;
+      }
+    }
+  }
+  if (separable) {
+    column_ray_x_.assign(ray_x_.begin(), ray_x_.begin() + width_);
+    row_ray_y_.resize(static_cast<std::size_t>(height_));
+    for (int v = 0; v < height_; ++v) {
+      row_ray_y_[static_cast<std::size_t>(v)] = ray_y_[static_cast<std::size_t>(v) * width_];
+    }
+  }
+
   // Per-code planes through the projector centre and the code's centre row. With projector
   // distortion the row's rays are not exactly coplanar: fit the plane (smallest eigenvector of
   // the rays' scatter matrix, the plane passing through the centre by construction).

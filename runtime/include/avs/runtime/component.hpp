@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "avs/msg/type_registry.hpp"
@@ -136,6 +137,14 @@ class Component {
   virtual void on_activate() {}
   virtual void on_deactivate() {}
   virtual void on_shutdown() {}
+
+  /// Extra key/values for this component's status on /diagnostics (after the container's
+  /// callbacks / callback_ms_* values), e.g. dropped inputs. Called by the container's
+  /// diagnostics timer, possibly on another thread than the component's callbacks: guard
+  /// the state it reads.
+  virtual std::vector<std::pair<std::string, std::string>> diagnostic_values() const {
+    return {};
+  }
 
  protected:
   ComponentContext& context() { return context_; }

@@ -86,6 +86,11 @@ class RollingDecoder {
   /// Feed one frame (the image is copied when it is a positive). Returns depth_updated = true
   /// when the frame completed a positive/negative pair.
   DecodeResult push_frame(const PatternFrame& frame);
+  /// Same, but a depth map computed by this call is written to `depth_out` (width * height
+  /// floats, row-major) instead of the decoder's own buffer, e.g. straight into an outgoing
+  /// message; DecodeResult::depth_m then views `depth_out`. The decoder's own buffer (and
+  /// the point map) is left as it was.
+  DecodeResult push_frame(const PatternFrame& frame, std::span<float> depth_out);
   /// Feed a complete pair without copying (same bookkeeping as two push_frame calls).
   DecodeResult push_pair(const ImageView8& positive, const ImageView8& negative, int bit_index,
                          std::int64_t cycle);
@@ -101,10 +106,11 @@ class RollingDecoder {
 
  private:
   DecodeResult apply_pair(const ImageView8& positive, const ImageView8& negative, int bit_index,
-                          std::int64_t pair_index);
+                          std::int64_t pair_index, float* depth_out);
   bool accept_sequence(std::int64_t sequence);
   std::uint16_t fresh_mask() const;
   DecodeResult make_result(bool updated) const;
+  DecodeResult push_frame_to(const PatternFrame& frame, float* depth_out);
   void update_reference(const ImageView8& positive, const ImageView8& negative, int bit_index,
                         bool all_fresh);
   void fill_point_map();

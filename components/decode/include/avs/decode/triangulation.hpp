@@ -26,6 +26,14 @@ class DepthTable {
 
   const float* ray_x() const { return ray_x_.data(); }
   const float* ray_y() const { return ray_y_.data(); }
+  /// When every pixel's ray x depends on its column only and its ray y on its row only (checked
+  /// exactly, e.g. a camera without distortion): the x of one row (width floats) and the y of
+  /// one column (height floats), the same values as ray_x()/ray_y(); null otherwise. The kernel
+  /// then reads 8 bytes per pixel less.
+  const float* column_ray_x() const {
+    return column_ray_x_.empty() ? nullptr : column_ray_x_.data();
+  }
+  const float* row_ray_y() const { return row_ray_y_.empty() ? nullptr : row_ray_y_.data(); }
   /// 4 floats (a, b, c, 0) per binary code 0 .. 2^n, 16-byte aligned; codes >= code_count and
   /// the last entry are NaN so that their depth is NaN.
   const float* planes() const { return planes_.data(); }
@@ -47,6 +55,8 @@ class DepthTable {
   std::vector<float> ray_x_;
   std::vector<float> ray_y_;
   std::vector<float> planes_;
+  std::vector<float> column_ray_x_;
+  std::vector<float> row_ray_y_;
   double max_plane_fit_error_ = 0;
 };
 

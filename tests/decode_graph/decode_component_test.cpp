@@ -1,0 +1,447 @@
+// The `decode` component in one container, sim-time lockstep: a test source publishes the
+// Gray-code frames of a plane at 1.0 m facing the sensor (decode::render_plane, the same
+// geometry the decoder uses, noise and a shadowed box) at 1000 fps; a recorder checks every
+// /depth/image against the plane's true depth, its stamp against the frames, the 500 Hz
+// cadence, /timing, and what dropped / out-of-order frames do.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "avs/decode/synthetic_plane.hpp"
+#include "avs/graph/graph.hpp"
+#include "avs/runtime/component.hpp"
+#include "avs/runtime/container.hpp"
+
+namespace avs::decode {
+namespace {
+
+using runtime::ComponentContext;
+using runtime::ComponentSpec;
+using runtime::ParamSpec;
+
+constexpr int kBits = 9;
+constexpr int kFramesPerCycle = 2 * kBits;
+
+/// The scene both the source and the checks use: plane at 1.0 m, noise sigma 3, a shadow.
+const SyntheticScene& plane_scene() {
+  static const SyntheticScene scene = [] {
+    PlaneSceneConfig c;
+    c.plane_depth_m = 1.0;
+    c.noise_sigma = 3.0;
+    c.seed = 2024;
+    c.shadow_x0 = 200;
+    c.shadow_x1 = 280;
+    c.shadow_y0 = 150;
+    c.shadow_y1 = 250;
+    return render_plane(default_sensor_geometry(), c);
+  }();
+  return scene;
+}
+
+std::set<std::int64_t> as_set(const std::vector<double>& v) {
+  std::set<std::int64_t> s;
+  for (double x : v) s.insert(static_cast<std::int64_t>(x));
+  return s;
+}
+
+/// Publishes frame f (bit (f mod 2n) / 2, positive when f is even, cycle f / 2n) every
+/// 1 ms, stamped with the clock; skips `drop_frames` and sends each of `swap_frames` after
+/// its successor.
+class TestPlanePatterns final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    runtime::QosProfile keep_last_4;
+    keep_last_4.depth = 4;
+    return {.type = "test_plane_patterns",
+            .description = "tests: Gray-code frames of a plane at 1 m, 1000 fps",
+            .parameters = {ParamSpec::real_list("drop_frames", {}, "", "frame numbers never sent"),
+                           ParamSpec::real_list("swap_frames", {}, "",
+                                                "frame numbers sent after the next one")},
+            .publishes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
+                                                                      keep_last_4)},
+            .subscribes = {}};
+  }
+
+  explicit TestPlanePatterns(ComponentContext& ctx)
+      : Component(ctx),
+        pattern_(ctx.publisher<msgs::avs_msgs::PatternFrame>("pattern")),
+        drop_(as_set(ctx.param<std::vector<double>>("drop_frames"))),
+        swap_(as_set(ctx.param<std::vector<double>>("swap_frames"))) {}
+
+  void on_activate() override {
+    context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
+  }
+
+  /// Stamp (ns) of every frame number made so far, sent or not.
+  std::vector<std::int64_t> stamps_ns;
+
+ private:
+  void tick() {
+    const std::int64_t f = next_++;
+    const runtime::Time now = context().now();
+    stamps_ns.push_back(now.ns);
+    auto frame = make_frame(f, now);
+    if (held_) {  // the swapped frame goes after this one
+      if (!drop_.contains(f)) pattern_.publish(frame);
+      pattern_.publish(std::move(held_));
+      held_.reset();
+      return;
+    }
+    if (drop_.contains(f)) return;
+    if (swap_.contains(f)) {
+      held_ = std::move(frame);
+      return;
+    }
+    pattern_.publish(std::move(frame));
+  }
+
+  std::shared_ptr<const msgs::avs_msgs::PatternFrame> make_frame(std::int64_t f,
+                                                                 runtime::Time now) {
+    const SyntheticScene& scene = plane_scene();
+    auto m = runtime::make_sample<msgs::avs_msgs::PatternFrame>();
+    runtime::to_ros_time(now, m->header.stamp);
+    runtime::set_string(m->header.frame_id, "camera");
+    const int slot = static_cast<int>(f % kFramesPerCycle);
+    m->bit_index = static_cast<std::uint8_t>(slot / 2);
+    m->bit_count = kBits;
+    m->positive = slot % 2 == 0;
+    m->cycle = static_cast<std::uint32_t>(f / kFramesPerCycle);
+    auto& image = m->image;
+    image.header.stamp = m->header.stamp;
+    runtime::set_string(image.header.frame_id, "camera");
+    runtime::set_string(image.encoding, "mono8");
+    image.width = static_cast<std::uint32_t>(scene.width);
+    image.height = static_cast<std::uint32_t>(scene.height);
+    image.step = image.width;
+    const auto& pixels = scene.frames[static_cast<std::size_t>(slot)];
+    runtime::resize_sequence(image.data, static_cast<std::uint32_t>(pixels.size()));
+    std::copy(pixels.begin(), pixels.end(), image.data._buffer);
+    return m;
+  }
+
+  runtime::Publisher<msgs::avs_msgs::PatternFrame> pattern_;
+  std::set<std::int64_t> drop_;
+  std::set<std::int64_t> swap_;
+  std::int64_t next_ = 0;
+  std::shared_ptr<const msgs::avs_msgs::PatternFrame> held_;
+};
+
+/// Per depth image: stamp, and its agreement with the plane's true depth.
+struct DepthRecord {
+  std::int64_t stamp_ns = 0;
+  std::int64_t valid = 0;  ///< finite pixels
+  std::int64_t lit = 0;    ///< directly lit, not shadowed
+  std::int64_t lit_valid = 0;
+  std::int64_t shadow_valid = 0;
+  std::int64_t far_off = 0;  ///< valid pixels more than 2 code steps (40 mm) off
+  double rms_m = 0;          ///< over valid lit pixels
+};
+
+class TestDepthRecorder final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    return {.type = "test_depth_recorder",
+            .description = "tests: checks /depth/image against the test plane",
+            .parameters = {},
+            .publishes = {},
+            .subscribes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
+                           runtime::port<msgs::sensor_msgs::PointCloud2>("points", "/depth/points"),
+                           runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing")}};
+  }
+
+  explicit TestDepthRecorder(ComponentContext& ctx) : Component(ctx) {
+    ctx.subscribe<msgs::sensor_msgs::Image>(
+        "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(m); });
+    ctx.subscribe<msgs::sensor_msgs::PointCloud2>(
+        "points", [this](runtime::SamplePtr<msgs::sensor_msgs::PointCloud2> m) {
+          points.push_back(m);
+          if (points.size() > 2) points.erase(points.begin());
+        });
+    ctx.subscribe<msgs::avs_msgs::StageTiming>(
+        "timing",
+        [this](runtime::SamplePtr<msgs::avs_msgs::StageTiming> m) { timing.push_back(m); });
+  }
+
+  std::vector<DepthRecord> depth;
+  std::vector<std::string> encodings;
+  runtime::SamplePtr<msgs::sensor_msgs::Image> last_depth;
+  std::vector<runtime::SamplePtr<msgs::sensor_msgs::PointCloud2>> points;
+  std::vector<runtime::SamplePtr<msgs::avs_msgs::StageTiming>> timing;
+
+ private:
+  void on_depth(const runtime::SamplePtr<msgs::sensor_msgs::Image>& m) {
+    const SyntheticScene& scene = plane_scene();
+    last_depth = m;
+    encodings.emplace_back(runtime::get_string(m->encoding));
+    DepthRecord r;
+    r.stamp_ns = runtime::from_ros_time(m->header.stamp).ns;
+    const auto* z = reinterpret_cast<const float*>(m->data._buffer);
+    const std::size_t pixels = std::min<std::size_t>(m->data._length / 4, scene.lit.size());
+    double sum = 0;
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const bool finite = std::isfinite(z[i]);
+      r.valid += finite ? 1 : 0;
+      if (scene.shadowed[i]) {
+        r.shadow_valid += finite ? 1 : 0;
+        continue;
+      }
+      if (!scene.lit[i]) continue;
+      ++r.lit;
+      if (!finite) continue;
+      ++r.lit_valid;
+      const double e = z[i] - scene.true_depth_m[i];
+      sum += e * e;
+      r.far_off += std::abs(e) > 0.04 ? 1 : 0;
+    }
+    r.rms_m = r.lit_valid > 0 ? std::sqrt(sum / static_cast<double>(r.lit_valid)) : 0.0;
+    depth.push_back(r);
+  }
+};
+
+AVS_REGISTER_COMPONENT(TestPlanePatterns);
+AVS_REGISTER_COMPONENT(TestDepthRecorder);
+
+/// Runs decode + source + recorder for `duration_s` of sim time in one lockstep container.
+struct GraphRun {
+  std::unique_ptr<graph::Graph> graph;
+  std::unique_ptr<runtime::Container> container;
+  TestPlanePatterns* source = nullptr;
+  TestDepthRecorder* recorder = nullptr;
+  runtime::Component* decode = nullptr;
+
+  std::string diagnostic(const std::string& key) const {
+    for (const auto& [k, v] : decode->diagnostic_values()) {
+      if (k == key) return v;
+    }
+    return "<missing " + key + ">";
+  }
+  std::int64_t count(const std::string& key) const { return std::stoll(diagnostic(key)); }
+};
+
+GraphRun run_graph(int domain, double duration_s, const std::string& decode_params,
+                   const std::string& source_params = "{}") {
+  setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("avs_decode_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "graph.yaml").string();
+  {
+    std::ofstream out(file);
+    out << "domain_id: " << domain << "\n"
+        << "clock: {source: sim, mode: lockstep, duration_s: " << duration_s << "}\n"
+        << "containers:\n"
+        << "  - name: depth\n"
+        << "    executor: single_threaded\n"
+        << "    components:\n"
+        << "      - {type: test_plane_patterns, name: source, parameters: " << source_params
+        << "}\n"
+        << "      - {type: decode, name: decode, parameters: " << decode_params << "}\n"
+        << "      - {type: test_depth_recorder, name: recorder}\n";
+  }
+  graph::LoadResult loaded = graph::load_graph(file, {});
+  std::filesystem::remove_all(dir);
+  for (const auto& e : loaded.errors) ADD_FAILURE() << e.str();
+  GraphRun run;
+  if (!loaded.ok()) return run;
+  run.graph = std::make_unique<graph::Graph>(std::move(*loaded.graph));
+  run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
+  EXPECT_EQ(run.container->run(), 0);
+  run.source = dynamic_cast<TestPlanePatterns*>(run.container->find_component("source"));
+  run.recorder = dynamic_cast<TestDepthRecorder*>(run.container->find_component("recorder"));
+  run.decode = run.container->find_component("decode");
+  EXPECT_NE(run.source, nullptr);
+  EXPECT_NE(run.recorder, nullptr);
+  EXPECT_NE(run.decode, nullptr);
+  return run;
+}
+
+/// Section 4.3 with the default layout: code step dz = 19.2 mm at the image centre; a code
+/// triangulated at its centre errs uniformly by +-dz/2, RMS dz / sqrt(12) = 5.5 mm.
+constexpr double kCodeStepM = 0.0192;
+const double kQuantisationRmsM = kCodeStepM / std::sqrt(12.0);
+
+void expect_accurate(const DepthRecord& r, const std::string& what) {
+  SCOPED_TRACE(what);
+  EXPECT_GE(r.lit_valid, r.lit * 99 / 100);
+  EXPECT_EQ(r.shadow_valid, 0);
+  EXPECT_LT(r.far_off * 200, r.valid);  // < 0.5 %
+  EXPECT_LE(r.rms_m, 1.25 * kQuantisationRmsM);
+}
+
+TEST(DecodeComponent, RollingDepthPerPairMatchesThePlane) {
+  const GraphRun run = run_graph(140, 0.1, "{publish_points: true}");
+  ASSERT_NE(run.recorder, nullptr);
+  const auto& stamps = run.source->stamps_ns;
+  const auto& depth = run.recorder->depth;
+  ASSERT_GE(stamps.size(), 90u);
+  // One depth image per pair: frame pairs (0,1), (2,3), ... -> stamp of the negative.
+  const std::size_t pairs = stamps.size() / 2;
+  ASSERT_EQ(depth.size(), pairs);
+  for (std::size_t p = 0; p < pairs; ++p) {
+    EXPECT_EQ(depth[p].stamp_ns, stamps[2 * p + 1]) << "pair " << p;
+    if (p > 0) {
+      EXPECT_EQ(depth[p].stamp_ns - depth[p - 1].stamp_ns, 2'000'000) << "500 Hz";
+    }
+    EXPECT_EQ(run.recorder->encodings[p], "32FC1");
+    if (p < kBits - 1) {
+      EXPECT_EQ(depth[p].valid, 0) << "pair " << p << ": not all bits measured yet";
+    } else {
+      expect_accurate(depth[p], "pair " + std::to_string(p));
+    }
+  }
+  std::printf(
+      "depth RMS %.2f mm (quantisation dz/sqrt(12) = %.2f mm), lit valid %.3f %%\n",
+      1000 * depth.back().rms_m, 1000 * kQuantisationRmsM,
+      100.0 * static_cast<double>(depth.back().lit_valid) / static_cast<double>(depth.back().lit));
+  // /timing: one per depth image, same stamp.
+  const auto& timing = run.recorder->timing;
+  ASSERT_EQ(timing.size(), depth.size());
+  for (std::size_t p = 0; p < pairs; ++p) {
+    EXPECT_EQ(runtime::from_ros_time(timing[p]->header.stamp).ns, depth[p].stamp_ns);
+    EXPECT_EQ(runtime::get_string(timing[p]->stage), "decode");
+    EXPECT_GT(timing[p]->processing_ms, 0.0);
+  }
+  // Points: organised XYZ, z equal to the depth image.
+  ASSERT_FALSE(run.recorder->points.empty());
+  const auto& cloud = *run.recorder->points.back();
+  const auto& last = *run.recorder->last_depth;
+  EXPECT_EQ(cloud.width, last.width);
+  EXPECT_EQ(cloud.height, last.height);
+  EXPECT_EQ(cloud.point_step, 12u);
+  ASSERT_EQ(cloud.data._length, 3 * last.data._length);
+  const auto* xyz = reinterpret_cast<const float*>(cloud.data._buffer);
+  const auto* z = reinterpret_cast<const float*>(last.data._buffer);
+  const std::size_t centre = 256 * 512 + 300;
+  EXPECT_EQ(xyz[3 * centre + 2], z[centre]);
+  EXPECT_NEAR(xyz[3 * centre], z[centre] * (300 - 255.5) / 628.8, 1e-3);
+  // Diagnostics.
+  EXPECT_EQ(run.count("dropped_frames"), 0);
+  EXPECT_EQ(run.count("out_of_order_frames"), 0);
+  EXPECT_EQ(run.count("depth_published"), static_cast<std::int64_t>(pairs));
+  EXPECT_EQ(run.count("frames_received"), static_cast<std::int64_t>(stamps.size()));
+  EXPECT_GT(std::stod(run.diagnostic("processing_ms_mean")), 0.0);
+}
+
+TEST(DecodeComponent, DroppedFrameIsCountedAndInvalidatesOnlyItsBitsWindow) {
+  // Frame 2 * 18 + 6 = the positive of bit 3 in cycle 2 is lost: pair (42, 43) cannot be
+  // decoded; bit 3 is missing from the window until it is measured again in cycle 3.
+  const std::int64_t lost = 2 * kFramesPerCycle + 2 * 3;
+  const GraphRun run = run_graph(141, 0.1, "{}", "{drop_frames: [" + std::to_string(lost) + "]}");
+  ASSERT_NE(run.recorder, nullptr);
+  EXPECT_EQ(run.count("dropped_frames"), 1);
+  EXPECT_EQ(run.count("incomplete_pairs"), 1);
+  EXPECT_EQ(run.count("out_of_order_frames"), 0);
+  const auto& stamps = run.source->stamps_ns;
+  const auto& depth = run.recorder->depth;
+  const std::size_t pairs = stamps.size() / 2;
+  ASSERT_EQ(depth.size(), pairs - 1);  // no depth for the broken pair
+  const auto lost_pair = static_cast<std::size_t>(lost / 2);
+  const std::size_t remeasured = lost_pair + kBits;
+  for (const DepthRecord& r : depth) {
+    const auto frame = static_cast<std::size_t>(
+        std::find(stamps.begin(), stamps.end(), r.stamp_ns) - stamps.begin());
+    ASSERT_LT(frame, stamps.size());
+    ASSERT_EQ(frame % 2, 1u) << "depth stamped with a negative frame";
+    const std::size_t pair = frame / 2;
+    EXPECT_NE(pair, lost_pair);
+    if (pair < kBits - 1 || (pair > lost_pair && pair < remeasured)) {
+      EXPECT_EQ(r.valid, 0) << "pair " << pair << ": bit 3 is missing from its window";
+    } else {
+      expect_accurate(r, "pair " + std::to_string(pair));  // never a bit in the wrong place
+    }
+  }
+}
+
+TEST(DecodeComponent, OutOfOrderFrameIsDiscardedNotMisplaced) {
+  // The positive of bit 5 in cycle 2 arrives after its negative: the negative has no positive
+  // (incomplete), the late positive is older than the newest frame (out of order, discarded).
+  const std::int64_t late = 2 * kFramesPerCycle + 2 * 5;
+  const GraphRun run = run_graph(142, 0.1, "{max_bit_age_pairs: 18}",
+                                 "{swap_frames: [" + std::to_string(late) + "]}");
+  ASSERT_NE(run.recorder, nullptr);
+  EXPECT_EQ(run.count("out_of_order_frames"), 1);
+  EXPECT_EQ(run.count("incomplete_pairs"), 1);
+  EXPECT_EQ(run.count("dropped_frames"), 1);  // seen as a gap when the negative came first
+  // With max_bit_age_pairs = 2n a static scene rides through: every map after the first
+  // cycle is complete and right.
+  const auto& depth = run.recorder->depth;
+  ASSERT_GT(depth.size(), 40u);
+  for (std::size_t i = kBits - 1; i < depth.size(); ++i) {
+    expect_accurate(depth[i], "image " + std::to_string(i));
+  }
+}
+
+TEST(DecodeComponent, FullCycleModePublishesOncePerCycleLikeDecodeFullCycle) {
+  const GraphRun run = run_graph(143, 0.08, "{mode: full_cycle}");
+  ASSERT_NE(run.recorder, nullptr);
+  const auto& stamps = run.source->stamps_ns;
+  const auto& depth = run.recorder->depth;
+  ASSERT_EQ(depth.size(), stamps.size() / kFramesPerCycle);
+  for (std::size_t c = 0; c < depth.size(); ++c) {
+    EXPECT_EQ(depth[c].stamp_ns, stamps[c * kFramesPerCycle + kFramesPerCycle - 1]);
+    expect_accurate(depth[c], "cycle " + std::to_string(c));
+  }
+  // Bit-identical to decode_full_cycle of the same frames.
+  const SyntheticScene& scene = plane_scene();
+  std::vector<PatternFrame> frames;
+  for (int b = 0; b < kBits; ++b) {
+    frames.push_back(scene.frame(b, Polarity::kPositive, 0));
+    frames.push_back(scene.frame(b, Polarity::kNegative, 0));
+  }
+  DecoderConfig config;
+  const FullCycleResult full = decode_full_cycle(config, frames);
+  const auto* z = reinterpret_cast<const float*>(run.recorder->last_depth->data._buffer);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < full.depth_m.size(); ++i) {
+    const bool same = std::isnan(z[i]) ? std::isnan(full.depth_m[i]) : z[i] == full.depth_m[i];
+    differ += same ? 0 : 1;
+  }
+  EXPECT_EQ(differ, 0u);
+}
+
+TEST(DecodeComponent, WrongFrameSizeFailsTheContainerLoudly) {
+  // A calibration for a 256 x 256 camera does not match the 512 x 512 frames.
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("avs_decode_cal_" + std::to_string(getpid()) + ".yaml");
+  {
+    std::ofstream out(file);
+    out << "camera: {width: 256, height: 256, fx: 314.4, fy: 314.4, cx: 127.5, cy: 127.5}\n";
+  }
+  setenv("AVS_DOMAIN_ID", "144", 1);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("avs_decode_graph_bad_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string graph_file = (dir / "graph.yaml").string();
+  {
+    std::ofstream out(graph_file);
+    out << "domain_id: 144\nclock: {source: sim, mode: lockstep, duration_s: 0.01}\n"
+        << "containers:\n  - name: depth\n    components:\n"
+        << "      - {type: test_plane_patterns, name: source}\n"
+        << "      - {type: decode, name: decode, parameters: {calibration_file: " << file.string()
+        << "}}\n";
+  }
+  graph::LoadResult loaded = graph::load_graph(graph_file, {});
+  ASSERT_TRUE(loaded.ok());
+  runtime::Container container(*loaded.graph, loaded.graph->containers.front());
+  testing::internal::CaptureStderr();
+  EXPECT_EQ(container.run(), 1);
+  const std::string err = testing::internal::GetCapturedStderr();
+  EXPECT_NE(err.find("size 512x512, the calibration's camera is 256x256"), std::string::npos)
+      << err;
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(file);
+}
+
+}  // namespace
+}  // namespace avs::decode
