@@ -137,6 +137,9 @@ struct Writer::Impl {
                                       index.message_index_offsets);
     index.message_index_length = scratch.size();
     if (Status s = file.write(scratch); !s.ok()) return s;
+    // Every finished chunk reaches the kernel now: a killed recorder loses at most the chunk
+    // being filled (docs/bag.md, repair), never staged records of earlier ones.
+    if (Status s = file.flush(); !s.ok()) return s;
     chunk_indexes.push_back(std::move(index));
     chunks_written.fetch_add(1);
     bytes_written.store(file.position());

@@ -1,0 +1,360 @@
+// `avs bag` end to end: record a running graph (other processes) and read the values back,
+// play into a subscriber and compare byte for byte, SIGKILL then repair, SIGTERM closes
+// cleanly, and loss is counted and reported, never silent. DDS domains 160-164.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "avs/bag/qos_yaml.hpp"
+#include "avs/introspection/cdr_reader.hpp"
+#include "avs/introspection/type_database.hpp"
+#include "avs/mcap/info.hpp"
+#include "avs/mcap/reader.hpp"
+#include "avs/msg/type_registry.hpp"
+#include "avs/runtime/raw_topic.hpp"
+#include "bag_process.hpp"
+#include "std_msgs.h"
+
+namespace avs::bag::test {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+fs::path temp_dir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("avs_bag_test_" + std::to_string(getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+std::string talker_graph() {
+  return source_dir() + "/launch_config/talker_listener.yaml";
+}
+
+int exit_code(int status) {
+  return status >= 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+struct Recorded {
+  std::string topic;
+  std::vector<std::uint8_t> bytes;
+  mcap::Timestamp log_time = 0;
+  mcap::Timestamp publish_time = 0;
+};
+
+std::vector<Recorded> read_all(const fs::path& file, bool allow_truncated = false) {
+  mcap::Reader reader;
+  EXPECT_TRUE(reader.open(file).ok());
+  std::vector<Recorded> out;
+  mcap::ReadOptions o;
+  o.allow_truncated = allow_truncated;
+  const mcap::Status s = reader.read_messages(
+      [&](const mcap::MessageView& m) {
+        const auto* p = reinterpret_cast<const std::uint8_t*>(m.data.data());
+        out.push_back({m.channel->topic, std::vector<std::uint8_t>(p, p + m.data.size()),
+                       m.log_time, m.publish_time});
+        return true;
+      },
+      o);
+  EXPECT_TRUE(s.ok()) << s.to_string();
+  return out;
+}
+
+/// The talker's "<seq> <address>" strings -> seq.
+std::vector<std::uint64_t> chatter_sequence(const std::vector<Recorded>& messages) {
+  std::vector<std::uint64_t> seqs;
+  for (const auto& m : messages) {
+    if (m.topic != "/chatter") continue;
+    const auto v = introspection::decode_cdr(introspection::built_in_types(),
+                                             "std_msgs::msg::dds_::String_", m.bytes);
+    seqs.push_back(std::stoull(v.at("data").string_value));
+  }
+  return seqs;
+}
+
+void expect_consecutive(const std::vector<std::uint64_t>& seqs, const char* what) {
+  for (std::size_t i = 1; i < seqs.size(); ++i) {
+    ASSERT_EQ(seqs[i], seqs[i - 1] + 1) << what << ": gap at index " << i;
+  }
+}
+
+/// Records /chatter and /talker_count of the talker graph for `seconds` (own domain); returns
+/// the recorder's output.
+std::string record_talker(int domain, const fs::path& file, const char* seconds) {
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"}, domain,
+                   temp_dir() / ("graph" + std::to_string(domain) + ".log"));
+  EXPECT_TRUE(graph.started());
+  std::this_thread::sleep_for(1500ms);
+  AvsProcess rec(
+      {"bag", "record", "/chatter", "talker_count", "-o", file.string(), "--duration", seconds},
+      domain, temp_dir() / ("record" + std::to_string(domain) + ".log"));
+  const int status = rec.wait(30s);
+  const std::string out = rec.output();
+  EXPECT_EQ(exit_code(status), 0) << out;
+  return out;
+}
+
+TEST(BagQos, OfferedQosYamlRoundTripsAndReadsRosbag2Text) {
+  runtime::dds::EndpointQos a;
+  a.reliable = false;
+  a.depth = 5;
+  a.deadline = runtime::Duration(2'500'000'000);
+  runtime::dds::EndpointQos b;
+  b.transient_local = true;
+  b.keep_all = true;
+  const auto back = parse_offered_qos_yaml(offered_qos_yaml({a, b}));
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_FALSE(back[0].reliable);
+  EXPECT_EQ(back[0].depth, 5);
+  ASSERT_TRUE(back[0].deadline.has_value());
+  EXPECT_EQ(back[0].deadline->count(), 2'500'000'000);
+  EXPECT_FALSE(back[0].lifespan.has_value());
+  EXPECT_TRUE(back[1].transient_local);
+  EXPECT_TRUE(back[1].keep_all);
+  // What rosbag2 (Humble) writes for a reliable, volatile, system-default-history publisher.
+  const auto ros = parse_offered_qos_yaml(
+      "- history: 3\n  depth: 0\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: "
+      "2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n"
+      "  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n"
+      "  avoid_ros_namespace_conventions: false\n");
+  ASSERT_EQ(ros.size(), 1u);
+  EXPECT_TRUE(ros[0].reliable);
+  EXPECT_FALSE(ros[0].transient_local);
+  EXPECT_FALSE(ros[0].deadline.has_value());
+  EXPECT_THROW(parse_offered_qos_yaml("reliability: 1\n"), runtime::Error);
+}
+
+TEST(BagRecord, RecordsARunningGraphAndReadsTheValuesBack) {
+  constexpr int kDomain = 160;
+  const fs::path file = temp_dir() / "talker.mcap";
+  const std::string out = record_talker(kDomain, file, "2.5");
+  ASSERT_FALSE(HasFailure());
+  EXPECT_NE(out.find("/chatter"), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex("total: [0-9]+ received, [0-9]+ written, 0 lost")))
+      << out;
+
+  mcap::Reader reader;
+  ASSERT_TRUE(reader.open(file).ok());
+  ASSERT_TRUE(reader.read_summary().ok());
+  EXPECT_EQ(reader.header().profile, "ros2");
+  std::map<std::string, const mcap::Channel*> channels;
+  for (const auto& [id, c] : reader.summary().channels) channels[c.topic] = &c;
+  ASSERT_EQ(channels.size(), 2u);
+  for (const auto& [topic, type] :
+       {std::pair<std::string, std::string>{"/chatter", "std_msgs/msg/String"},
+        {"/talker_count", "std_msgs/msg/Float64"}}) {
+    ASSERT_TRUE(channels.count(topic)) << topic;
+    const mcap::Channel& c = *channels[topic];
+    EXPECT_EQ(c.message_encoding, "cdr");
+    const mcap::Schema& schema = reader.summary().schemas.at(c.schema_id);
+    EXPECT_EQ(schema.name, type);
+    EXPECT_EQ(schema.encoding, "ros2msg");
+    EXPECT_EQ(schema.data, introspection::ros2msg_definition(introspection::built_in_types(),
+                                                             introspection::dds_type_name(type)));
+    const auto qos = parse_offered_qos_yaml(c.metadata.at("offered_qos_profiles"));
+    ASSERT_EQ(qos.size(), 1u) << topic;
+    EXPECT_TRUE(qos[0].reliable);
+  }
+
+  const auto messages = read_all(file);
+  const auto seqs = chatter_sequence(messages);
+  ASSERT_GT(seqs.size(), 200u);
+  expect_consecutive(seqs, "/chatter");
+  std::vector<std::uint64_t> counts;
+  for (const auto& m : messages) {
+    if (m.topic != "/talker_count") continue;
+    const auto v = introspection::decode_cdr(introspection::built_in_types(),
+                                             "std_msgs::msg::dds_::Float64_", m.bytes);
+    counts.push_back(static_cast<std::uint64_t>(v.at("data").float_value));
+  }
+  expect_consecutive(counts, "/talker_count");
+  // The same talker ticks publish both: the value ranges overlap almost entirely.
+  ASSERT_FALSE(counts.empty());
+  EXPECT_LE(std::max(seqs.front(), counts.front()) - std::min(seqs.front(), counts.front()), 2u);
+  for (const auto& m : messages) {
+    EXPECT_GT(m.publish_time, 0u);
+    // Source timestamp (publisher's clock) before receive time (same host clock), with slack.
+    EXPECT_LE(m.publish_time, m.log_time + 5'000'000);
+    EXPECT_LE(m.log_time - std::min(m.log_time, m.publish_time), 1'000'000'000u);
+  }
+
+  AvsProcess info({"bag", "info", file.string()}, kDomain, temp_dir() / "info160.log");
+  ASSERT_EQ(exit_code(info.wait(10s)), 0);
+  const std::string text = info.output();
+  EXPECT_NE(text.find("std_msgs/msg/String"), std::string::npos) << text;
+  EXPECT_NE(text.find("/talker_count"), std::string::npos) << text;
+  EXPECT_NE(text.find(std::to_string(seqs.size())), std::string::npos) << text;
+}
+
+TEST(BagPlay, RepublishesTheRecordedBytesWithTheirTiming) {
+  constexpr int kDomain = 161;
+  const fs::path file = temp_dir() / "to_play.mcap";
+  record_talker(kDomain, file, "1.5");
+  ASSERT_FALSE(HasFailure());
+  const auto recorded = read_all(file);
+  std::vector<const Recorded*> chatter;
+  for (const auto& m : recorded) {
+    if (m.topic == "/chatter") chatter.push_back(&m);
+  }
+  ASSERT_FALSE(chatter.empty());
+
+  runtime::dds::Participant participant(kDomain);
+  runtime::dds::EndpointQos qos;
+  qos.keep_all = true;
+  runtime::dds::RawReader reader(participant, *msg::find_type("std_msgs::msg::dds_::String_"),
+                                 "rt/replayed", qos);
+  AvsProcess play({"bag", "play", file.string(), "--topics", "/chatter", "--remap",
+                   "/chatter:=/replayed", "--delay", "1.5"},
+                  kDomain, temp_dir() / "play161.log");
+  std::vector<std::vector<std::uint8_t>> got;
+  std::vector<std::chrono::steady_clock::time_point> when;
+  int status = -1;
+  const auto end = std::chrono::steady_clock::now() + 30s;
+  while (std::chrono::steady_clock::now() < end) {
+    reader.take(256, [&](ddsi_serdata* d, const dds_sample_info_t&) {
+      std::vector<std::uint8_t> bytes(ddsi_serdata_size(d));
+      ddsi_serdata_to_ser(d, 0, bytes.size(), bytes.data());
+      got.push_back(std::move(bytes));
+      when.push_back(std::chrono::steady_clock::now());
+      ddsi_serdata_unref(d);
+    });
+    if (status < 0) {
+      status = play.wait(10ms);
+      if (status >= 0) std::this_thread::sleep_for(300ms);  // last samples in flight
+    } else if (got.size() >= chatter.size()) {
+      break;
+    } else {
+      std::this_thread::sleep_for(10ms);
+    }
+    if (status >= 0 && got.size() >= chatter.size()) break;
+  }
+  ASSERT_EQ(exit_code(status), 0) << play.output();
+  ASSERT_EQ(got.size(), chatter.size()) << play.output();
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    ASSERT_EQ(got[i], chatter[i]->bytes) << "sample " << i;
+  }
+  // Original timing: the replay spans the recording's span (rate 1).
+  const double recorded_s =
+      static_cast<double>(chatter.back()->log_time - chatter.front()->log_time) * 1e-9;
+  const double replayed_s = std::chrono::duration<double>(when.back() - when.front()).count();
+  EXPECT_NEAR(replayed_s, recorded_s, 0.25 * recorded_s + 0.1);
+}
+
+TEST(BagRecord, SigkillLeavesAFileReadableToItsLastChunkAndRepairRestoresTheSummary) {
+  constexpr int kDomain = 162;
+  const fs::path file = temp_dir() / "killed.mcap";
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=500"}, kDomain,
+                   temp_dir() / "graph162.log");
+  std::this_thread::sleep_for(1500ms);
+  AvsProcess rec({"bag", "record", "/chatter", "-o", file.string(), "--compression", "lz4",
+                  "--flush-interval", "0.2"},
+                 kDomain, temp_dir() / "record162.log");
+  std::this_thread::sleep_for(3s);
+  rec.signal(SIGKILL);
+  ASSERT_GE(rec.wait(10s), 0);
+
+  {
+    mcap::Reader reader;
+    ASSERT_TRUE(reader.open(file).ok());
+    const mcap::Status s = reader.read_summary();
+    EXPECT_FALSE(s.ok()) << "a killed recorder cannot have written the summary";
+  }
+  const auto before = read_all(file, /*allow_truncated=*/true);
+  const auto seqs = chatter_sequence(before);
+  ASSERT_GT(seqs.size(), 100u) << "at 500 Hz, chunks closed every 0.2 s";
+  expect_consecutive(seqs, "/chatter before repair");
+
+  AvsProcess repair({"bag", "repair", file.string()}, kDomain, temp_dir() / "repair162.log");
+  ASSERT_EQ(exit_code(repair.wait(30s)), 0) << repair.output();
+  mcap::Reader reader;
+  ASSERT_TRUE(reader.open(file).ok());
+  ASSERT_TRUE(reader.read_summary().ok());
+  ASSERT_TRUE(reader.summary().statistics.has_value());
+  EXPECT_EQ(reader.summary().statistics->message_count, seqs.size());
+  const auto after = chatter_sequence(read_all(file));
+  EXPECT_EQ(after, seqs);
+}
+
+TEST(BagRecord, SigtermClosesTheFileCleanly) {
+  constexpr int kDomain = 163;
+  const fs::path file = temp_dir() / "terminated.mcap";
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"}, kDomain,
+                   temp_dir() / "graph163.log");
+  std::this_thread::sleep_for(1500ms);
+  AvsProcess rec({"bag", "record", "-a", "-x", "diagnostics", "-o", file.string()}, kDomain,
+                 temp_dir() / "record163.log");
+  std::this_thread::sleep_for(2s);
+  rec.signal(SIGTERM);
+  const int status = rec.wait(20s);
+  ASSERT_EQ(exit_code(status), 0) << rec.output();
+  mcap::Reader reader;
+  ASSERT_TRUE(reader.open(file).ok());
+  ASSERT_TRUE(reader.read_summary().ok());
+  std::set<std::string> topics;
+  for (const auto& [id, c] : reader.summary().channels) topics.insert(c.topic);
+  EXPECT_TRUE(topics.count("/chatter")) << rec.output();
+  EXPECT_FALSE(topics.count("/diagnostics")) << "excluded by -x";
+  mcap::ScanResult scan;
+  EXPECT_TRUE(reader.scan(scan).ok());
+  EXPECT_TRUE(scan.data_crc_checked);
+}
+
+TEST(BagRecord, LossIsCountedAndReportedNeverSilent) {
+  constexpr int kDomain = 164;
+  constexpr std::uint64_t kSent = 3000;
+  const fs::path file = temp_dir() / "lossy.mcap";
+  // A recorder whose own queue holds a single sample: a burst overflows it.
+  AvsProcess rec({"bag", "record", "/burst", "-o", file.string(), "--queue-size", "0"}, kDomain,
+                 temp_dir() / "record164.log");
+  runtime::dds::Participant participant(kDomain);
+  runtime::QosProfile q;
+  q.depth = static_cast<std::uint32_t>(kSent);
+  runtime::dds::Topic topic(participant, &std_msgs_msg_dds__String__desc, "rt/burst", q);
+  runtime::dds::Writer writer(participant, topic, q);
+  const auto end = std::chrono::steady_clock::now() + 20s;
+  while (writer.matched_readers() == 0 && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_GT(writer.matched_readers(), 0u) << rec.output();
+  std::this_thread::sleep_for(300ms);
+  char text[32];
+  for (std::uint64_t i = 0; i < kSent; ++i) {
+    std::snprintf(text, sizeof text, "%llu", static_cast<unsigned long long>(i));
+    std_msgs_msg_dds__String_ s{text};
+    writer.write(&s);
+  }
+  ASSERT_EQ(dds_wait_for_acks(writer.get(), DDS_SECS(10)), DDS_RETCODE_OK);
+  std::this_thread::sleep_for(500ms);
+  rec.signal(SIGINT);
+  const int status = rec.wait(20s);
+  const std::string out = rec.output();
+  EXPECT_EQ(exit_code(status), 3) << "exit status 3 when messages were lost\n" << out;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(
+      out, m, std::regex("total: ([0-9]+) received, ([0-9]+) written, ([0-9]+) lost")))
+      << out;
+  const std::uint64_t received = std::stoull(m[1]), written = std::stoull(m[2]),
+                      lost = std::stoull(m[3]);
+  EXPECT_EQ(received, kSent) << out;
+  EXPECT_GT(lost, 0u) << out;
+  EXPECT_EQ(written + lost, kSent) << "every message is either in the file or reported lost\n"
+                                   << out;
+  EXPECT_NE(out.find("dropped by the recorder (queue full)"), std::string::npos) << out;
+  mcap::BagInfo info;
+  ASSERT_TRUE(mcap::read_bag_info(file, info).ok());
+  EXPECT_EQ(info.message_count, written);
+}
+
+}  // namespace
+}  // namespace avs::bag::test
