@@ -89,6 +89,48 @@ TEST(PairKernel, AllInstructionSetsAgree) {
   }
 }
 
+TEST(PairKernel, BitsOnlyUpdateAgreesAcrossInstructionSets) {
+  // depth_m = null (the window is not complete yet): Gray words and flags only.
+  const int width = 77, height = 5, pixels = width * height;  // odd width: the scalar tail too
+  std::mt19937 random(4);
+  std::uniform_int_distribution<int> byte(0, 255), word(0, 511);
+  std::vector<std::uint8_t> positive(pixels), negative(pixels);
+  std::vector<std::uint16_t> gray(pixels), valid(pixels);
+  for (int i = 0; i < pixels; ++i) {
+    positive[i] = static_cast<std::uint8_t>(byte(random));
+    negative[i] = static_cast<std::uint8_t>(byte(random));
+    gray[i] = static_cast<std::uint16_t>(word(random));
+    valid[i] = static_cast<std::uint16_t>(word(random));
+  }
+  for (bool correction : {true, false}) {
+    std::vector<std::vector<std::uint16_t>> grays, valids;
+    for (KernelIsa isa : {KernelIsa::kScalar, KernelIsa::kSse2, KernelIsa::kAvx2}) {
+      if (isa == KernelIsa::kAvx2 && best_kernel_isa() != KernelIsa::kAvx2) continue;
+      grays.push_back(gray);
+      valids.push_back(valid);
+      PairUpdateArgs a;
+      a.positive = positive.data();
+      a.positive_stride = width;
+      a.negative = negative.data();
+      a.negative_stride = width;
+      a.width = width;
+      a.height = height;
+      a.gray = grays.back().data();
+      a.valid = valids.back().data();
+      a.bit_position = 5;
+      a.threshold_psi = 10;
+      a.code_correction = correction;
+      a.full_mask = 511;
+      update_pair(a, isa);
+    }
+    EXPECT_NE(grays[0], gray);
+    for (std::size_t j = 1; j < grays.size(); ++j) {
+      EXPECT_EQ(grays[j], grays[0]) << "isa " << j;
+      EXPECT_EQ(valids[j], valids[0]) << "isa " << j;
+    }
+  }
+}
+
 TEST(PairKernel, DistortedCameraRaysAreNotSeparable) {
   SensorGeometry g = default_sensor_geometry();
   g.camera.k1 = -0.1;
