@@ -23,6 +23,7 @@
 #include "avs/mcap/info.hpp"
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/error.hpp"
+#include "avs/runtime/raw_topic.hpp"
 #include "avs_msgs.h"
 
 extern char** environ;
@@ -43,8 +44,21 @@ struct BenchArgs {
   int domain = -1;
 };
 
-BenchArgs parse_args(const std::vector<std::string>& args) {
+/// Options as `--key=value` (`avs bench` hands unknown options and positional words over
+/// separately, so `--key value` may arrive out of order) or `--key value`.
+BenchArgs parse_args(const std::vector<std::string>& raw) {
   BenchArgs a;
+  std::vector<std::string> args;
+  for (const auto& w : raw) {
+    if (w == "--") continue;
+    const auto eq = w.find('=');
+    if (w.rfind("--", 0) == 0 && eq != std::string::npos) {
+      args.push_back(w.substr(0, eq));
+      args.push_back(w.substr(eq + 1));
+    } else {
+      args.push_back(w);
+    }
+  }
   for (std::size_t i = 0; i < args.size(); ++i) {
     auto value = [&]() -> const std::string& {
       if (i + 1 >= args.size())
@@ -72,8 +86,8 @@ BenchArgs parse_args(const std::vector<std::string>& args) {
       for (std::string c; std::getline(ss, c, ',');) a.compressions.push_back(c);
     } else if (k == "--help" || k == "-h") {
       std::printf(
-          "avs bench bag [--duration S] [--fps N] [--size PX] [--compression none,lz4,zstd]\n"
-          "              [--dir DIR] [--keep] [--domain ID]\n"
+          "avs bench bag [--duration=S] [--fps=N] [--size=PX] [--compression=none,lz4,zstd]\n"
+          "              [--dir=DIR] [--keep] [--domain=ID]\n"
           "Records /bench_bag/pattern_frames (avs_msgs/PatternFrame, PXxPX mono8, N fps) with\n"
           "/bench_bag/target (1 kHz), /bench_bag/torque (1 kHz) and /bench_bag/match (100 Hz) from "
           "a\n"
@@ -114,25 +128,51 @@ void stamp(std_msgs_msg_dds__Header_& h, const char* frame) {
   h.frame_id = const_cast<char*>(frame);
 }
 
+/// A data writer with explicit QoS (keep all), as the bench's publisher needs.
+class BenchWriter {
+ public:
+  BenchWriter(const runtime::dds::Participant& p, const runtime::dds::Topic& t,
+              const runtime::dds::EndpointQos& q)
+      : entity_(runtime::check_dds(dds_create_writer(p.get(), t.get(), q.to_dds().get(), nullptr),
+                                   "create writer on " + t.name())),
+        name_(t.name()) {}
+  void write(const void* sample) {
+    runtime::check_dds(dds_write(entity_.get(), sample), "write " + name_);
+  }
+  std::uint32_t matched_readers() const {
+    dds_publication_matched_status_t s{};
+    runtime::check_dds(dds_get_publication_matched_status(entity_.get(), &s), "matched " + name_);
+    return s.current_count;
+  }
+  dds_entity_t get() const { return entity_.get(); }
+
+ private:
+  runtime::dds::Entity entity_;
+  std::string name_;
+};
+
 /// Publishes for `duration_s`, then prints "sent <topic> <count>" lines and exits.
 [[noreturn]] void run_publisher(const BenchArgs& a) {
   runtime::dds::Participant participant(a.domain);
-  runtime::QosProfile frame_qos;  // reliable, keep last 16: a 1 kHz image stream
-  frame_qos.depth = 16;
-  runtime::QosProfile small_qos;
-  small_qos.depth = 100;
+  // Reliable, KEEP_ALL: when the recorder acknowledges late the writer waits (Cyclone's writer
+  // history cache, WhcHigh 8 MB in avs's default config) instead of dropping. A reliable
+  // KEEP_LAST writer drops unacknowledged samples from its history when it runs ahead, and
+  // Cyclone 0.10's reader is not told (no SAMPLE_LOST): docs/bag.md, loss accounting.
+  runtime::dds::EndpointQos qos;
+  qos.keep_all = true;
+  const runtime::QosProfile topic_qos;
   runtime::dds::Topic frames_t(participant, &avs_msgs_msg_dds__PatternFrame__desc,
-                               "rt/bench_bag/pattern_frames", frame_qos);
+                               "rt/bench_bag/pattern_frames", topic_qos);
   runtime::dds::Topic target_t(participant, &avs_msgs_msg_dds__TargetObservation__desc,
-                               "rt/bench_bag/target", small_qos);
+                               "rt/bench_bag/target", topic_qos);
   runtime::dds::Topic torque_t(participant, &avs_msgs_msg_dds__JointTorqueCommand__desc,
-                               "rt/bench_bag/torque", small_qos);
+                               "rt/bench_bag/torque", topic_qos);
   runtime::dds::Topic match_t(participant, &avs_msgs_msg_dds__MatchResult__desc,
-                              "rt/bench_bag/match", small_qos);
-  runtime::dds::Writer frames(participant, frames_t, frame_qos);
-  runtime::dds::Writer target(participant, target_t, small_qos);
-  runtime::dds::Writer torque(participant, torque_t, small_qos);
-  runtime::dds::Writer match(participant, match_t, small_qos);
+                              "rt/bench_bag/match", topic_qos);
+  BenchWriter frames(participant, frames_t, qos);
+  BenchWriter target(participant, target_t, qos);
+  BenchWriter torque(participant, torque_t, qos);
+  BenchWriter match(participant, match_t, qos);
 
   // Pattern-like frames: vertical Gray-code stripes of 9 bits, positive and negative, with
   // 3-bit noise (what a camera sees of the projected patterns).
@@ -271,16 +311,11 @@ Run run_one(const BenchArgs& a, const std::string& compression, const std::files
   std::vector<std::string> words = {self,
                                     "bench",
                                     "bag",
-                                    "--role",
-                                    "publisher",
-                                    "--duration",
-                                    std::to_string(a.duration_s),
-                                    "--fps",
-                                    std::to_string(a.fps),
-                                    "--size",
-                                    std::to_string(a.width),
-                                    "--domain",
-                                    std::to_string(a.domain)};
+                                    "--role=publisher",
+                                    "--duration=" + std::to_string(a.duration_s),
+                                    "--fps=" + std::to_string(a.fps),
+                                    "--size=" + std::to_string(a.width),
+                                    "--domain=" + std::to_string(a.domain)};
   std::vector<char*> argv;
   for (auto& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
@@ -318,7 +353,8 @@ Run run_one(const BenchArgs& a, const std::string& compression, const std::files
     }
   }
   // Everything sent has been acknowledged: what is not in the queue or file by now is lost.
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  // Acknowledged samples may still sit in Cyclone's delivery queue on a loaded machine.
+  std::this_thread::sleep_for(std::chrono::seconds(2));
   recorder.stop();
   run.status = recorder.status();
   mcap::BagInfo info;
@@ -391,6 +427,16 @@ bench::Report run_bench(const std::vector<std::string>& args) {
                                             ? r.sent.at("/bench_bag/pattern_frames")
                                             : 0));
     report.notes.push_back(note);
+    for (const auto& t : r.status.topics) {
+      const auto sent_it = r.sent.find(t.topic);
+      const std::uint64_t topic_sent = sent_it == r.sent.end() ? 0 : sent_it->second;
+      if (topic_sent != t.written || t.lost() > 0) {
+        report.notes.push_back("  " + c + " " + t.topic + ": " + std::to_string(topic_sent) +
+                               " sent, " + std::to_string(t.received) + " received, " +
+                               std::to_string(t.written) + " written, " + std::to_string(t.lost()) +
+                               " reported lost");
+      }
+    }
     if (missing > r.status.lost) {
       report.notes.push_back("WARNING " + c + ": " + std::to_string(missing - r.status.lost) +
                              " message(s) missing that the recorder did not report");
@@ -398,7 +444,7 @@ bench::Report run_bench(const std::vector<std::string>& args) {
   }
   report.notes.push_back(
       "No peer: rosbag2 is not installed on this machine; the publisher is a second process "
-      "(reliable, keep last 16 for frames).");
+      "(reliable, keep all).");
   return report;
 }
 
