@@ -29,8 +29,7 @@ Eigen::Isometry3f extrapolate(const Eigen::Isometry3f& older, double t_older,
       Eigen::AngleAxisf(rotation.angle() * static_cast<float>(scale), rotation.axis())
           .toRotationMatrix();
   // Rotate about the object's origin, translate its origin at the mean velocity.
-  const Eigen::Vector3f v =
-      (newer.translation() - older.translation()) * static_cast<float>(scale);
+  const Eigen::Vector3f v = (newer.translation() - older.translation()) * static_cast<float>(scale);
   Eigen::Isometry3f out = Eigen::Isometry3f::Identity();
   out.linear() = r * newer.linear();
   out.translation() = newer.translation() + v;
@@ -46,10 +45,9 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
       tracker_(model_, config_.tracker),
       scene_(&empty_) {
   if (!(config_.depth_min_m < config_.depth_max_m)) {
-    throw std::invalid_argument("MatchingPipeline: depth_min_m (" +
-                                std::to_string(config_.depth_min_m) +
-                                ") must be below depth_max_m (" +
-                                std::to_string(config_.depth_max_m) + ")");
+    throw std::invalid_argument(
+        "MatchingPipeline: depth_min_m (" + std::to_string(config_.depth_min_m) +
+        ") must be below depth_max_m (" + std::to_string(config_.depth_max_m) + ")");
   }
   if (config_.lag_compensation_s < 0.0 || config_.velocity_window_s <= 0.0) {
     throw std::invalid_argument(
@@ -116,8 +114,8 @@ ObjectModel load_object_model(const std::string& name_or_path, const std::string
     object.model_points = preset.model_points;
     object.scene_points = preset.scene_points;
     object.symmetry = preset.symmetry;
-    object.mesh_path = (models_dir.empty() ? default_models_dir() : models_dir) + "/" +
-                       preset.name + ".ply";
+    object.mesh_path =
+        (models_dir.empty() ? default_models_dir() : models_dir) + "/" + preset.name + ".ply";
   }
   if (object.mesh_path == name_or_path) {
     object.name = std::filesystem::path(name_or_path).stem().string();

@@ -1,0 +1,436 @@
+// matching: model matching of the paper's section 6 as a component. Per depth image
+// (/depth/image, 32FC1 metres, NaN invalid, stamped with the newest camera frame used): target
+// mask by the depth window, S-PCD (Eq. 27, voxels, outliers), Tracker (LRF initial alignment,
+// ICP of Eqs. 21-26, loss and re-initialisation) -> /object/pose (camera frame),
+// /object/pose_world (through the head's joint angles interpolated at the image's stamp),
+// /object/match, /timing and, optionally, /object/scene_points.
+#include <cmath>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <optional>
+
+#include "avs/geometry/head_kinematics.hpp"
+#include "avs/matching/pipeline.hpp"
+#include "avs/runtime/component.hpp"
+
+namespace avs::matching {
+
+using runtime::ComponentContext;
+using runtime::ComponentSpec;
+using runtime::ParamSpec;
+
+namespace {
+
+Eigen::Vector3d triple(const std::vector<double>& v, const std::string& name) {
+  if (v.size() != 3) {
+    throw std::invalid_argument("parameter '" + name + "' needs 3 values (x, y, z), got " +
+                                std::to_string(v.size()));
+  }
+  return {v[0], v[1], v[2]};
+}
+
+template <class Pose>
+void set_pose(const Eigen::Isometry3d& T, Pose& pose) {
+  const Eigen::Quaterniond q(T.linear());
+  pose.position.x = T.translation().x();
+  pose.position.y = T.translation().y();
+  pose.position.z = T.translation().z();
+  pose.orientation.x = q.x();
+  pose.orientation.y = q.y();
+  pose.orientation.z = q.z();
+  pose.orientation.w = q.w();
+}
+
+}  // namespace
+
+/// Joint angles at a given time from a short history of joint states: linear interpolation
+/// between the two samples around it; beyond the newest sample, extrapolation at the last
+/// velocity for at most max_extrapolation_s.
+class JointHistory {
+ public:
+  struct Sample {
+    double t_s;
+    double pan_rad, tilt_rad;
+  };
+  void add(const Sample& s) {
+    if (!samples_.empty() && s.t_s < samples_.back().t_s) samples_.clear();  // time went back
+    if (!samples_.empty() && s.t_s == samples_.back().t_s) samples_.pop_back();
+    samples_.push_back(s);
+    while (samples_.size() > 2 && samples_.back().t_s - samples_.front().t_s > keep_s_) {
+      samples_.pop_front();
+    }
+  }
+  [[nodiscard]] bool empty() const { return samples_.empty(); }
+  [[nodiscard]] std::optional<Sample> at(double t_s, double max_extrapolation_s) const {
+    if (samples_.empty()) return std::nullopt;
+    if (samples_.size() == 1 || t_s <= samples_.front().t_s) {
+      if (samples_.front().t_s - t_s > max_extrapolation_s) return std::nullopt;
+      return samples_.front();
+    }
+    std::size_t i = 1;
+    while (i + 1 < samples_.size() && samples_[i].t_s < t_s) ++i;
+    const Sample& a = samples_[i - 1];
+    const Sample& b = samples_[i];
+    if (t_s - b.t_s > max_extrapolation_s) return std::nullopt;  // history too old
+    const double w = (t_s - a.t_s) / (b.t_s - a.t_s);            // > 1: extrapolation
+    return Sample{t_s, a.pan_rad + w * (b.pan_rad - a.pan_rad),
+                  a.tilt_rad + w * (b.tilt_rad - a.tilt_rad)};
+  }
+
+ private:
+  std::deque<Sample> samples_;
+  double keep_s_ = 0.2;
+};
+
+class MatchingComponent final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    runtime::QosProfile keep_last_4;
+    keep_last_4.depth = 4;
+    runtime::QosProfile keep_last_100;
+    keep_last_100.depth = 100;
+    runtime::QosProfile best_effort_2;
+    best_effort_2.depth = 2;
+    best_effort_2.reliability = runtime::Reliability::best_effort;
+    const PipelineConfig d;  // defaults
+    return {
+        .type = "matching",
+        .description =
+            "model matching (paper section 6): /depth/image + /head/joint_states -> "
+            "/object/pose (camera), /object/pose_world, /object/match, /timing",
+        .parameters =
+            {ParamSpec::string("model", "ken",
+                               "ken | cube | cylinder (shipped models/*.ply) or a mesh path "
+                               "(PLY, STL, OBJ; metres)"),
+             ParamSpec::string("models_dir", "",
+                               "folder of the built-in models (empty: $AVS_SOURCE_DIR/models, "
+                               "else the source tree's)"),
+             ParamSpec::integer("model_points", 0, 0, 100000, "",
+                                "M-PCD size; 0 = the paper's (302 ken, 488 cube, 248 cylinder, "
+                                "300 for a mesh)"),
+             ParamSpec::integer("scene_points", 0, 0, 100000, "",
+                                "i_number of Eq. 27; 0 = the paper's (250 ken, 350 cube, 300 "
+                                "cylinder, 250 for a mesh)"),
+             ParamSpec::real("scene_voxel_m", 0.0, 0.0, 1.0, "m",
+                             "S-PCD voxel side r; 0 = the M-PCD's voxel side"),
+             ParamSpec::integer("outlier_neighbours", 20, 0, 1000, "",
+                                "neighbours averaged by the outlier test"),
+             ParamSpec::real("outlier_distance_m", 0.03, 0.0, 10.0, "m",
+                             "drop S-PCD points whose mean neighbour distance is larger"),
+             ParamSpec::real_list("icp_iterations", {0, 0, 1}, "",
+                                  "[n1, n2, n3] per frame on 1/4, 1/2, all scene points"),
+             ParamSpec::string("icp_metric", "point_to_plane", "per-frame ICP metric",
+                               {"point_to_plane", "point_to_point"}),
+             ParamSpec::real("max_rmse_m", 0.01, 0.0, 1.0, "m",
+                             "a frame fails above this ICP RMSE (0 = model's mean spacing)"),
+             ParamSpec::real("min_inlier_ratio", 0.3, 0.0, 1.0, "",
+                             "a frame fails below this inlier ratio"),
+             ParamSpec::integer("failures_before_loss", 3, 1, 100000, "",
+                                "consecutive failed frames that declare the target lost"),
+             ParamSpec::integer("min_scene_points", 15, 3, 100000, "",
+                                "fewer S-PCD points: no match (counts as a failure)"),
+             ParamSpec::boolean("constant_velocity", true,
+                                "ICP starts from the constant-velocity prediction"),
+             ParamSpec::real("lag_compensation_s", d.lag_compensation_s, 0.0, 0.1, "s",
+                             "extrapolate the published pose by this at the tracked velocity "
+                             "(docs/matching.md: measured lag and why the default)"),
+             ParamSpec::real("velocity_window_s", d.velocity_window_s, 1e-4, 1.0, "s",
+                             "span of tracked poses the velocity is estimated over"),
+             ParamSpec::real("depth_min_m", 0.3, 0.0, 100.0, "m", "target mask: nearest depth"),
+             ParamSpec::real("depth_max_m", 1.5, 0.0, 100.0, "m", "target mask: farthest depth"),
+             ParamSpec::real("fx_px", 628.8, 1.0, 1e5, "px", "focal length along x"),
+             ParamSpec::real("fy_px", 628.8, 1.0, 1e5, "px", "focal length along y"),
+             ParamSpec::real("cx_px", 255.5, -1e4, 1e4, "px", "principal point x"),
+             ParamSpec::real("cy_px", 255.5, -1e4, 1e4, "px", "principal point y"),
+             ParamSpec::real_list("head_p_world_pan_m", {0.0, 0.0, 0.0}, "m",
+                                  "pan axis foot point in the world (geometry::HeadConfig)"),
+             ParamSpec::real_list("head_p_pan_tilt_m", {0.0, 0.0, 0.0}, "m",
+                                  "tilt axis point in the pan-rotated frame"),
+             ParamSpec::real_list("head_p_tilt_camera_m", {0.04, 0.0, 0.0}, "m",
+                                  "camera centre in the tilt-rotated frame (x = Eq. 15's a)"),
+             ParamSpec::string("joint_names", "pan,tilt",
+                               "names of q1 and q2 in /head/joint_states"),
+             ParamSpec::real("joint_max_extrapolation_s", 0.02, 0.0, 10.0, "s",
+                             "joint states older than this at the image's stamp: no world pose"),
+             ParamSpec::boolean("publish_scene_points", false,
+                                "publish the S-PCD on /object/scene_points (camera frame)"),
+             ParamSpec::string("report_dir", "",
+                               "tests: write <name>.csv (one row per image) on deactivate")},
+        .publishes = {runtime::port<msgs::geometry_msgs::PoseStamped>("pose", "/object/pose"),
+                      runtime::port<msgs::geometry_msgs::PoseStamped>("pose_world",
+                                                                      "/object/pose_world"),
+                      runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match"),
+                      runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing",
+                                                                 keep_last_100),
+                      runtime::port<msgs::sensor_msgs::PointCloud2>(
+                          "scene_points", "/object/scene_points", best_effort_2)},
+        .subscribes = {
+            runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
+            runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states")}};
+  }
+
+  explicit MatchingComponent(ComponentContext& ctx)
+      : Component(ctx),
+        pose_(ctx.publisher<msgs::geometry_msgs::PoseStamped>("pose")),
+        pose_world_(ctx.publisher<msgs::geometry_msgs::PoseStamped>("pose_world")),
+        match_(ctx.publisher<msgs::avs_msgs::MatchResult>("match")),
+        timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
+        scene_points_(ctx.publisher<msgs::sensor_msgs::PointCloud2>("scene_points")),
+        publish_scene_points_(ctx.param<bool>("publish_scene_points")),
+        report_dir_(ctx.param<std::string>("report_dir")),
+        max_extrapolation_s_(ctx.param<double>("joint_max_extrapolation_s")) {
+    const ObjectModel object =
+        load_object_model(ctx.param<std::string>("model"), ctx.param<std::string>("models_dir"));
+    ModelCloudConfig model_config;
+    const auto model_points = ctx.param<std::int64_t>("model_points");
+    model_config.target_points =
+        model_points > 0 ? static_cast<std::size_t>(model_points) : object.model_points;
+    PipelineConfig config;
+    config.camera.fx_px = static_cast<float>(ctx.param<double>("fx_px"));
+    config.camera.fy_px = static_cast<float>(ctx.param<double>("fy_px"));
+    config.camera.cx_px = static_cast<float>(ctx.param<double>("cx_px"));
+    config.camera.cy_px = static_cast<float>(ctx.param<double>("cy_px"));
+    config.depth_min_m = static_cast<float>(ctx.param<double>("depth_min_m"));
+    config.depth_max_m = static_cast<float>(ctx.param<double>("depth_max_m"));
+    const auto scene_points = ctx.param<std::int64_t>("scene_points");
+    config.scene.target_points =
+        scene_points > 0 ? static_cast<std::size_t>(scene_points) : object.scene_points;
+    config.scene.voxel_size_m = static_cast<float>(ctx.param<double>("scene_voxel_m"));
+    config.scene.outlier_neighbours =
+        static_cast<std::size_t>(ctx.param<std::int64_t>("outlier_neighbours"));
+    config.scene.outlier_mean_distance_m =
+        static_cast<float>(ctx.param<double>("outlier_distance_m"));
+    const auto iterations = ctx.param<std::vector<double>>("icp_iterations");
+    if (iterations.size() != 3) {
+      throw std::invalid_argument("parameter 'icp_iterations' needs 3 values [n1, n2, n3], got " +
+                                  std::to_string(iterations.size()));
+    }
+    for (std::size_t k = 0; k < 3; ++k) {
+      if (iterations[k] < 0 || iterations[k] > 1000 || iterations[k] != std::floor(iterations[k]))
+        throw std::invalid_argument("parameter 'icp_iterations': expected integers in [0, 1000]");
+      config.tracker.icp.iterations[k] = static_cast<int>(iterations[k]);
+    }
+    config.tracker.icp.metric = ctx.param<std::string>("icp_metric") == "point_to_point"
+                                    ? IcpMetric::point_to_point
+                                    : IcpMetric::point_to_plane;
+    config.tracker.max_rmse_m = static_cast<float>(ctx.param<double>("max_rmse_m"));
+    config.tracker.min_inlier_ratio = static_cast<float>(ctx.param<double>("min_inlier_ratio"));
+    config.tracker.failures_before_loss =
+        static_cast<int>(ctx.param<std::int64_t>("failures_before_loss"));
+    config.tracker.min_scene_points =
+        static_cast<std::size_t>(ctx.param<std::int64_t>("min_scene_points"));
+    config.tracker.constant_velocity = ctx.param<bool>("constant_velocity");
+    config.lag_compensation_s = ctx.param<double>("lag_compensation_s");
+    config.velocity_window_s = ctx.param<double>("velocity_window_s");
+    pipeline_.emplace(make_model_cloud(object.mesh, model_config), config);
+    log().info("model '", object.name, "' from ", object.mesh_path, ": ",
+               pipeline_->model().points_m.size(), " M-PCD points, voxel ",
+               1e3 * pipeline_->model().voxel_size_m, " mm");
+
+    head_.p_world_pan_m =
+        triple(ctx.param<std::vector<double>>("head_p_world_pan_m"), "head_p_world_pan_m");
+    head_.p_pan_tilt_m =
+        triple(ctx.param<std::vector<double>>("head_p_pan_tilt_m"), "head_p_pan_tilt_m");
+    head_.p_tilt_camera_m =
+        triple(ctx.param<std::vector<double>>("head_p_tilt_camera_m"), "head_p_tilt_camera_m");
+    const std::string names = ctx.param<std::string>("joint_names");
+    const auto comma = names.find(',');
+    if (comma == std::string::npos) {
+      throw std::invalid_argument("parameter 'joint_names' needs 'pan,tilt', got '" + names + "'");
+    }
+    joint_names_ = {names.substr(0, comma), names.substr(comma + 1)};
+
+    ctx.subscribe<msgs::sensor_msgs::JointState>(
+        "joint_states",
+        [this](runtime::SamplePtr<msgs::sensor_msgs::JointState> m) { on_joints(*m); });
+    ctx.subscribe<msgs::sensor_msgs::Image>(
+        "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
+  }
+
+  void on_deactivate() override {
+    log().info(images_, " depth images, ", poses_, " poses, ", world_poses_, " world poses, ",
+               initialisations_, " initial alignments, state ",
+               to_string(pipeline_->tracker().state()));
+    if (report_dir_.empty()) return;
+    const std::string file = report_dir_ + "/" + context().name() + ".csv";
+    std::ofstream out(file);
+    out << "t_s,state,pose_valid,x_m,y_m,z_m,qx,qy,qz,qw,world,wx_m,wy_m,wz_m,rmse_m,inliers,"
+           "scene_points,processing_ms\n"
+        << csv_;
+    if (!out) log().error("cannot write ", file);
+  }
+
+ private:
+  void on_joints(const msgs::sensor_msgs::JointState& m) {
+    std::optional<double> q[2];
+    for (std::uint32_t i = 0; i < m.name._length && i < m.position._length; ++i) {
+      const std::string_view name = runtime::get_string(m.name._buffer[i]);
+      for (std::size_t axis = 0; axis < 2; ++axis) {
+        if (name == joint_names_[axis]) q[axis] = m.position._buffer[i];
+      }
+    }
+    if (!q[0] || !q[1]) {
+      if (!warned_joint_names_) {
+        log().warn("/head/joint_states without both joints '", joint_names_[0], "' and '",
+                   joint_names_[1], "': ignored");
+      }
+      warned_joint_names_ = true;
+      return;
+    }
+    joints_.add({runtime::from_ros_time(m.header.stamp).seconds(), *q[0], *q[1]});
+  }
+
+  void on_depth(const msgs::sensor_msgs::Image& image) {
+    const std::string_view encoding = runtime::get_string(image.encoding);
+    if (encoding != "32FC1" || image.is_bigendian != 0 || image.step % 4 != 0 ||
+        static_cast<std::uint64_t>(image.step) * image.height > image.data._length ||
+        image.step < 4ull * image.width) {
+      if (!warned_encoding_) {
+        log().error("depth image '", encoding, "' ", image.width, "x", image.height, " step ",
+                    image.step, " (", image.data._length,
+                    " bytes) ignored: expected little-endian 32FC1 metres");
+      }
+      warned_encoding_ = true;
+      return;
+    }
+    ++images_;
+    const double stamp_s = runtime::from_ros_time(image.header.stamp).seconds();
+    const DepthView depth{reinterpret_cast<const float*>(image.data._buffer),
+                          static_cast<int>(image.width), static_cast<int>(image.height),
+                          static_cast<int>(image.step / 4)};
+    const PipelineOutput out = pipeline_->process(depth, stamp_s);
+    if (out.track.initialised_this_frame) ++initialisations_;
+
+    std::optional<Eigen::Isometry3d> T_world_model;
+    if (out.has_pose) {
+      ++poses_;
+      const Eigen::Isometry3d T_camera_model = out.T_camera_model.cast<double>();
+      publish_pose(pose_, image.header.stamp, "camera", T_camera_model);
+      if (const auto q = joints_.at(stamp_s, max_extrapolation_s_)) {
+        T_world_model = geometry::T_world_camera(head_, q->pan_rad, q->tilt_rad) * T_camera_model;
+        publish_pose(pose_world_, image.header.stamp, "world", *T_world_model);
+        ++world_poses_;
+      } else if (!warned_no_joints_) {
+        log().warn("no /head/joint_states around t = ", stamp_s,
+                   " s: /object/pose_world not published");
+        warned_no_joints_ = true;
+      }
+    }
+    publish_match(image, out);
+    publish_timing(image, out.processing_ms);
+    if (publish_scene_points_) publish_cloud(image);
+    if (!report_dir_.empty()) report(stamp_s, out, T_world_model);
+  }
+
+  void publish_pose(const runtime::Publisher<msgs::geometry_msgs::PoseStamped>& publisher,
+                    const decltype(msgs::sensor_msgs::Image::header.stamp)& stamp,
+                    std::string_view frame, const Eigen::Isometry3d& T) {
+    auto msg = runtime::make_sample<msgs::geometry_msgs::PoseStamped>();
+    msg->header.stamp = stamp;
+    runtime::set_string(msg->header.frame_id, frame);
+    set_pose(T, msg->pose);
+    publisher.publish(std::move(msg));
+  }
+
+  static std::uint8_t state_of(const PipelineOutput& out) {
+    switch (out.track.state) {
+      case TrackingState::tracking:
+        return avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING;
+      case TrackingState::lost:
+        return avs_msgs_msg_dds__MatchResult_Constants_STATE_LOST;
+      case TrackingState::waiting:
+        return out.track.initialised_this_frame
+                   ? avs_msgs_msg_dds__MatchResult_Constants_STATE_INITIALISING
+                   : avs_msgs_msg_dds__MatchResult_Constants_STATE_IDLE;
+    }
+    return avs_msgs_msg_dds__MatchResult_Constants_STATE_IDLE;
+  }
+
+  void publish_match(const msgs::sensor_msgs::Image& image, const PipelineOutput& out) {
+    auto msg = runtime::make_sample<msgs::avs_msgs::MatchResult>();
+    msg->header.stamp = image.header.stamp;
+    runtime::set_string(msg->header.frame_id, "camera");
+    set_pose(out.T_camera_model.cast<double>(), msg->pose);
+    msg->rmse_m = out.track.icp.rmse_m;
+    msg->inliers = static_cast<std::uint32_t>(out.track.icp.inliers);
+    msg->scene_points = static_cast<std::uint32_t>(out.scene_points);
+    msg->iterations = static_cast<std::uint32_t>(out.track.icp.iterations);
+    msg->state = state_of(out);
+    msg->processing_time_ms = out.processing_ms;
+    match_.publish(std::move(msg));
+  }
+
+  void publish_timing(const msgs::sensor_msgs::Image& image, double processing_ms) {
+    auto msg = runtime::make_sample<msgs::avs_msgs::StageTiming>();
+    msg->header.stamp = image.header.stamp;
+    runtime::set_string(msg->header.frame_id, runtime::get_string(image.header.frame_id));
+    runtime::set_string(msg->stage, "matching");
+    msg->processing_ms = processing_ms;
+    timing_.publish(std::move(msg));
+  }
+
+  void publish_cloud(const msgs::sensor_msgs::Image& image) {
+    const Points& points = pipeline_->scene_points();
+    auto msg = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
+    msg->header.stamp = image.header.stamp;
+    runtime::set_string(msg->header.frame_id, "camera");
+    msg->height = 1;
+    msg->width = static_cast<std::uint32_t>(points.size());
+    runtime::resize_sequence(msg->fields, 3);
+    const char* names[3] = {"x", "y", "z"};
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      runtime::set_string(msg->fields._buffer[k].name, names[k]);
+      msg->fields._buffer[k].offset = 4 * k;
+      msg->fields._buffer[k].datatype = sensor_msgs_msg_dds__PointField_Constants_FLOAT32;
+      msg->fields._buffer[k].count = 1;
+    }
+    msg->is_bigendian = false;
+    msg->point_step = 12;
+    msg->row_step = 12 * msg->width;
+    msg->is_dense = true;
+    runtime::resize_sequence(msg->data, msg->row_step);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      std::memcpy(msg->data._buffer + 12 * i, points[i].data(), 12);
+    }
+    scene_points_.publish(std::move(msg));
+  }
+
+  void report(double stamp_s, const PipelineOutput& out,
+              const std::optional<Eigen::Isometry3d>& T_world_model) {
+    const Eigen::Vector3f p = out.T_camera_model.translation();
+    const Eigen::Quaternionf q(out.T_camera_model.linear());
+    const Eigen::Vector3d w =
+        T_world_model ? Eigen::Vector3d(T_world_model->translation()) : Eigen::Vector3d::Zero();
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%.6f,%d,%d,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%.6f,%d,%.6f,%.6f,%.6f,%.6f,%zu,%zu,"
+                  "%.3f\n",
+                  stamp_s, static_cast<int>(state_of(out)), out.has_pose ? 1 : 0, p.x(), p.y(),
+                  p.z(), q.x(), q.y(), q.z(), q.w(), T_world_model ? 1 : 0, w.x(), w.y(), w.z(),
+                  out.track.icp.rmse_m, out.track.icp.inliers, out.scene_points, out.processing_ms);
+    csv_ += line;
+  }
+
+  runtime::Publisher<msgs::geometry_msgs::PoseStamped> pose_;
+  runtime::Publisher<msgs::geometry_msgs::PoseStamped> pose_world_;
+  runtime::Publisher<msgs::avs_msgs::MatchResult> match_;
+  runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
+  runtime::Publisher<msgs::sensor_msgs::PointCloud2> scene_points_;
+  std::optional<MatchingPipeline> pipeline_;
+  geometry::HeadConfig head_;
+  std::array<std::string, 2> joint_names_;
+  JointHistory joints_;
+  bool publish_scene_points_;
+  std::string report_dir_;
+  double max_extrapolation_s_;
+  bool warned_encoding_ = false;
+  bool warned_no_joints_ = false;
+  bool warned_joint_names_ = false;
+  std::uint64_t images_ = 0, poses_ = 0, world_poses_ = 0, initialisations_ = 0;
+  std::string csv_;
+};
+
+AVS_REGISTER_COMPONENT(MatchingComponent);
+
+}  // namespace avs::matching
