@@ -22,6 +22,7 @@
 #include "avs/graph/graph.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
+#include "avs/sim/simulator.hpp"
 
 namespace avs::decode {
 namespace {
@@ -48,6 +49,29 @@ const SyntheticScene& plane_scene() {
   }();
   return scene;
 }
+
+/// What the recorder compares with: true depth, directly lit pixels, shadowed pixels.
+struct Truth {
+  std::vector<float> depth_m;
+  std::vector<std::uint8_t> lit;       ///< lit by a coded projector row, not shadowed
+  std::vector<std::uint8_t> shadowed;  ///< a surface the projector does not light
+};
+
+const Truth& plane_truth() {
+  static const Truth truth = [] {
+    const SyntheticScene& scene = plane_scene();
+    Truth t;
+    t.depth_m = scene.true_depth_m;
+    t.shadowed = scene.shadowed;
+    t.lit.resize(scene.lit.size());
+    for (std::size_t i = 0; i < t.lit.size(); ++i) t.lit[i] = scene.lit[i] && !scene.shadowed[i];
+    return t;
+  }();
+  return truth;
+}
+
+/// The truth the current test's source renders (set by the source before its first frame).
+const Truth* current_truth = nullptr;
 
 std::set<std::int64_t> as_set(const std::vector<double>& v) {
   std::set<std::int64_t> s;
@@ -80,6 +104,7 @@ class TestPlanePatterns final : public runtime::Component {
         swap_(as_set(ctx.param<std::vector<double>>("swap_frames"))) {}
 
   void on_activate() override {
+    current_truth = &plane_truth();
     context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
   }
 
@@ -137,6 +162,78 @@ class TestPlanePatterns final : public runtime::Component {
   std::shared_ptr<const msgs::avs_msgs::PatternFrame> held_;
 };
 
+/// The simulator (avs_sim_core) instead of the analytic plane: its renderer draws a plane 1.0 m
+/// in front of the camera (the head at rest, q = 0, looks along world +X; the camera sits 40 mm
+/// in front of the tilt axis), and its ground truth is what the depth is compared with.
+class TestSimPlanePatterns final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    runtime::QosProfile keep_last_4;
+    keep_last_4.depth = 4;
+    return {.type = "test_sim_plane_patterns",
+            .description = "tests: simulator frames of a plane 1 m in front of the camera",
+            .parameters = {ParamSpec::real("plane_x_m", 1.04, 0.1, 100.0, "m",
+                                           "plane's distance from the pan axis")},
+            .publishes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
+                                                                      keep_last_4)},
+            .subscribes = {}};
+  }
+
+  explicit TestSimPlanePatterns(ComponentContext& ctx)
+      : Component(ctx),
+        pattern_(ctx.publisher<msgs::avs_msgs::PatternFrame>("pattern")),
+        sim_(sim::SimulatorConfig{},
+             sim::Scene{{sim::make_background_plane(ctx.param<double>("plane_x_m"))}}) {
+    sim_.render(0, head_);  // ground truth of the (static) view
+    const sim::Renderer& r = sim_.renderer();
+    truth_.depth_m = r.depth_m();
+    truth_.lit.resize(truth_.depth_m.size());
+    truth_.shadowed.resize(truth_.depth_m.size());
+    for (std::size_t i = 0; i < truth_.lit.size(); ++i) {
+      truth_.lit[i] = r.code()[i] >= 0;
+      truth_.shadowed[i] = r.object_index()[i] >= 0 && r.code()[i] < 0;
+    }
+  }
+
+  void on_activate() override {
+    current_truth = &truth_;
+    context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
+  }
+
+  std::vector<std::int64_t> stamps_ns;
+  const Truth& truth() const { return truth_; }
+
+ private:
+  void tick() {
+    const runtime::Time now = context().now();
+    stamps_ns.push_back(now.ns);
+    const sim::SimFrame frame = sim_.render(next_++, head_);
+    auto m = runtime::make_sample<msgs::avs_msgs::PatternFrame>();
+    runtime::to_ros_time(now, m->header.stamp);
+    runtime::set_string(m->header.frame_id, "camera");
+    m->bit_index = static_cast<std::uint8_t>(frame.pattern.bit_index);
+    m->bit_count = kBits;
+    m->positive = frame.pattern.positive;
+    m->cycle = frame.pattern.cycle;
+    auto& image = m->image;
+    image.header.stamp = m->header.stamp;
+    runtime::set_string(image.header.frame_id, "camera");
+    runtime::set_string(image.encoding, "mono8");
+    image.width = static_cast<std::uint32_t>(frame.image.width);
+    image.height = static_cast<std::uint32_t>(frame.image.height);
+    image.step = image.width;
+    runtime::resize_sequence(image.data, static_cast<std::uint32_t>(frame.image.pixels.size()));
+    std::copy(frame.image.pixels.begin(), frame.image.pixels.end(), image.data._buffer);
+    pattern_.publish(std::move(m));
+  }
+
+  runtime::Publisher<msgs::avs_msgs::PatternFrame> pattern_;
+  sim::Simulator sim_;
+  sim::HeadState head_;
+  Truth truth_;
+  std::uint64_t next_ = 0;
+};
+
 /// Per depth image: stamp, and its agreement with the plane's true depth.
 struct DepthRecord {
   std::int64_t stamp_ns = 0;
@@ -181,26 +278,27 @@ class TestDepthRecorder final : public runtime::Component {
 
  private:
   void on_depth(const runtime::SamplePtr<msgs::sensor_msgs::Image>& m) {
-    const SyntheticScene& scene = plane_scene();
+    ASSERT_NE(current_truth, nullptr);
+    const Truth& truth = *current_truth;
     last_depth = m;
     encodings.emplace_back(runtime::get_string(m->encoding));
     DepthRecord r;
     r.stamp_ns = runtime::from_ros_time(m->header.stamp).ns;
     const auto* z = reinterpret_cast<const float*>(m->data._buffer);
-    const std::size_t pixels = std::min<std::size_t>(m->data._length / 4, scene.lit.size());
+    const std::size_t pixels = std::min<std::size_t>(m->data._length / 4, truth.lit.size());
     double sum = 0;
     for (std::size_t i = 0; i < pixels; ++i) {
       const bool finite = std::isfinite(z[i]);
       r.valid += finite ? 1 : 0;
-      if (scene.shadowed[i]) {
+      if (truth.shadowed[i]) {
         r.shadow_valid += finite ? 1 : 0;
         continue;
       }
-      if (!scene.lit[i]) continue;
+      if (!truth.lit[i]) continue;
       ++r.lit;
       if (!finite) continue;
       ++r.lit_valid;
-      const double e = z[i] - scene.true_depth_m[i];
+      const double e = z[i] - truth.depth_m[i];
       sum += e * e;
       r.far_off += std::abs(e) > 0.04 ? 1 : 0;
     }
@@ -211,12 +309,14 @@ class TestDepthRecorder final : public runtime::Component {
 
 AVS_REGISTER_COMPONENT(TestPlanePatterns);
 AVS_REGISTER_COMPONENT(TestDepthRecorder);
+AVS_REGISTER_COMPONENT(TestSimPlanePatterns);
 
 /// Runs decode + source + recorder for `duration_s` of sim time in one lockstep container.
 struct GraphRun {
   std::unique_ptr<graph::Graph> graph;
   std::unique_ptr<runtime::Container> container;
   TestPlanePatterns* source = nullptr;
+  TestSimPlanePatterns* sim_source = nullptr;
   TestDepthRecorder* recorder = nullptr;
   runtime::Component* decode = nullptr;
 
@@ -230,7 +330,8 @@ struct GraphRun {
 };
 
 GraphRun run_graph(int domain, double duration_s, const std::string& decode_params,
-                   const std::string& source_params = "{}") {
+                   const std::string& source_params = "{}",
+                   const std::string& source_type = "test_plane_patterns") {
   setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
   const auto dir = std::filesystem::temp_directory_path() /
                    ("avs_decode_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
@@ -244,7 +345,7 @@ GraphRun run_graph(int domain, double duration_s, const std::string& decode_para
         << "  - name: depth\n"
         << "    executor: single_threaded\n"
         << "    components:\n"
-        << "      - {type: test_plane_patterns, name: source, parameters: " << source_params
+        << "      - {type: " << source_type << ", name: source, parameters: " << source_params
         << "}\n"
         << "      - {type: decode, name: decode, parameters: " << decode_params << "}\n"
         << "      - {type: test_depth_recorder, name: recorder}\n";
@@ -258,9 +359,10 @@ GraphRun run_graph(int domain, double duration_s, const std::string& decode_para
   run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
   EXPECT_EQ(run.container->run(), 0);
   run.source = dynamic_cast<TestPlanePatterns*>(run.container->find_component("source"));
+  run.sim_source = dynamic_cast<TestSimPlanePatterns*>(run.container->find_component("source"));
   run.recorder = dynamic_cast<TestDepthRecorder*>(run.container->find_component("recorder"));
   run.decode = run.container->find_component("decode");
-  EXPECT_NE(run.source, nullptr);
+  EXPECT_TRUE(run.source != nullptr || run.sim_source != nullptr);
   EXPECT_NE(run.recorder, nullptr);
   EXPECT_NE(run.decode, nullptr);
   return run;
@@ -331,6 +433,9 @@ TEST(DecodeComponent, RollingDepthPerPairMatchesThePlane) {
   EXPECT_EQ(run.count("depth_published"), static_cast<std::int64_t>(pairs));
   EXPECT_EQ(run.count("frames_received"), static_cast<std::int64_t>(stamps.size()));
   EXPECT_GT(std::stod(run.diagnostic("processing_ms_mean")), 0.0);
+  std::printf("decode component: processing_ms_mean %s, processing_ms_max %s (wall clock)\n",
+              run.diagnostic("processing_ms_mean").c_str(),
+              run.diagnostic("processing_ms_max").c_str());
 }
 
 TEST(DecodeComponent, DroppedFrameIsCountedAndInvalidatesOnlyItsBitsWindow) {
@@ -380,6 +485,14 @@ TEST(DecodeComponent, OutOfOrderFrameIsDiscardedNotMisplaced) {
   for (std::size_t i = kBits - 1; i < depth.size(); ++i) {
     expect_accurate(depth[i], "image " + std::to_string(i));
   }
+  std::vector<double> ms;
+  for (const auto& t : run.recorder->timing) ms.push_back(t->processing_ms);
+  std::sort(ms.begin(), ms.end());
+  std::printf(
+      "decode component without points: /timing median %.3f ms, processing_ms_mean %s, "
+      "max %s (wall clock)\n",
+      ms[ms.size() / 2], run.diagnostic("processing_ms_mean").c_str(),
+      run.diagnostic("processing_ms_max").c_str());
 }
 
 TEST(DecodeComponent, FullCycleModePublishesOncePerCycleLikeDecodeFullCycle) {
@@ -408,6 +521,34 @@ TEST(DecodeComponent, FullCycleModePublishesOncePerCycleLikeDecodeFullCycle) {
     differ += same ? 0 : 1;
   }
   EXPECT_EQ(differ, 0u);
+}
+
+TEST(DecodeComponent, SimulatorPlaneAtOneMetre) {
+  // Frames from the simulator's renderer (its own pattern order, projector model, shading and
+  // noise) against its ground truth.
+  const GraphRun run = run_graph(145, 0.06, "{}", "{}", "test_sim_plane_patterns");
+  ASSERT_NE(run.sim_source, nullptr);
+  const Truth& truth = run.sim_source->truth();
+  double centre_depth = truth.depth_m[256 * 512 + 256];
+  EXPECT_NEAR(centre_depth, 1.0, 1e-3);
+  const auto& stamps = run.sim_source->stamps_ns;
+  const auto& depth = run.recorder->depth;
+  ASSERT_EQ(depth.size(), stamps.size() / 2);
+  ASSERT_GT(depth.size(), static_cast<std::size_t>(kBits + 5));
+  std::int64_t shadowed = 0;
+  for (std::uint8_t v : truth.shadowed) shadowed += v;
+  for (std::size_t p = kBits - 1; p < depth.size(); ++p) {
+    EXPECT_EQ(depth[p].stamp_ns, stamps[2 * p + 1]);
+    expect_accurate(depth[p], "pair " + std::to_string(p));
+  }
+  const DepthRecord& last = depth.back();
+  std::printf(
+      "simulator plane: depth RMS %.2f mm (dz/sqrt(12) = %.2f mm), lit valid %.3f %% of %lld, "
+      "unlit surface valid %lld of %lld\n",
+      1000 * last.rms_m, 1000 * kQuantisationRmsM,
+      100.0 * static_cast<double>(last.lit_valid) / static_cast<double>(last.lit),
+      static_cast<long long>(last.lit), static_cast<long long>(last.shadow_valid),
+      static_cast<long long>(shadowed));
 }
 
 TEST(DecodeComponent, WrongFrameSizeFailsTheContainerLoudly) {
