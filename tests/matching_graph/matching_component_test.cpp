@@ -1,0 +1,315 @@
+// The `matching` component in one container, sim-time lockstep: a test source publishes
+// /head/joint_states at 1 kHz (the pan swinging) and, at 500 Hz, z-buffer depth images
+// (matching's render_depth, 32FC1, NaN where empty) of the shipped ken moving across the room,
+// seen through the head's TRUE angles. A recorder checks that a pose comes out for every depth
+// image, stamped like it, in the camera frame ("camera") and in the world frame ("world"), both
+// against the source's ground truth, plus /object/match and /timing.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "avs/geometry/head_kinematics.hpp"
+#include "avs/graph/graph.hpp"
+#include "avs/matching/pipeline.hpp"
+#include "avs/matching/synthetic.hpp"
+#include "avs/runtime/component.hpp"
+#include "avs/runtime/container.hpp"
+
+namespace avs::matching {
+namespace {
+
+using runtime::ComponentContext;
+using runtime::ComponentSpec;
+using runtime::ParamSpec;
+
+constexpr double kF = 628.8;
+constexpr double kC = 255.5;
+
+/// Ground truth of the test scene: the ken 1 m ahead, moving to the left at 0.2 m/s while
+/// turning about the vertical; the head pans sinusoidally (0.1 rad, 2 Hz) and tilts down 0.05.
+Eigen::Isometry3d T_world_ken(double t) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.translation() = Eigen::Vector3d(1.0, -0.05 + 0.2 * t, 0.0);
+  // ken +Y (handle) up = world +Z, crosspiece across the view, then a slow turn about Z.
+  T.linear() = (Eigen::AngleAxisd(0.8 * t, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  return T;
+}
+double pan_at(double t) {
+  return -0.1 * std::sin(2.0 * M_PI * 2.0 * t);
+}
+constexpr double kTilt = 0.05;
+
+const geometry::HeadConfig& head_config() {
+  static const geometry::HeadConfig head;  // the component's defaults
+  return head;
+}
+
+class TestMatchingSource final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    return {
+        .type = "test_matching_source",
+        .description = "tests: joint states at 1 kHz and depth images of the ken at 500 Hz",
+        .parameters = {},
+        .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
+                      runtime::port<msgs::sensor_msgs::JointState>("joints", "/head/joint_states")},
+        .subscribes = {}};
+  }
+  explicit TestMatchingSource(ComponentContext& ctx)
+      : Component(ctx),
+        depth_(ctx.publisher<msgs::sensor_msgs::Image>("depth")),
+        joints_(ctx.publisher<msgs::sensor_msgs::JointState>("joints")),
+        mesh_(load_object_model("ken").mesh) {}
+  void on_activate() override {
+    context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
+  }
+
+ private:
+  void tick() {
+    const runtime::Time now = context().now();
+    const double t = now.seconds();
+    auto js = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    runtime::to_ros_time(now, js->header.stamp);
+    runtime::resize_sequence(js->name, 2);
+    runtime::set_string(js->name._buffer[0], "pan");
+    runtime::set_string(js->name._buffer[1], "tilt");
+    runtime::resize_sequence(js->position, 2);
+    js->position._buffer[0] = pan_at(t);
+    js->position._buffer[1] = kTilt;
+    joints_.publish(std::move(js));
+    if (tick_++ % 2 != 1) return;  // depth at 500 Hz, stamped at odd milliseconds
+    const Eigen::Isometry3d T_camera_ken =
+        geometry::T_world_camera(head_config(), pan_at(t), kTilt).inverse() * T_world_ken(t);
+    CameraIntrinsics camera{static_cast<float>(kF),
+                            static_cast<float>(kF),
+                            static_cast<float>(kC),
+                            static_cast<float>(kC),
+                            512,
+                            512};
+    const DepthImage image = render_depth(mesh_, T_camera_ken.cast<float>(), camera);
+    auto m = runtime::make_sample<msgs::sensor_msgs::Image>();
+    runtime::to_ros_time(now, m->header.stamp);
+    runtime::set_string(m->header.frame_id, "camera");
+    runtime::set_string(m->encoding, "32FC1");
+    m->width = 512;
+    m->height = 512;
+    m->step = 512 * 4;
+    runtime::resize_sequence(m->data, m->step * m->height);
+    auto* z = reinterpret_cast<float*>(m->data._buffer);
+    for (std::size_t i = 0; i < image.depth_m.size(); ++i) {
+      z[i] = image.depth_m[i] > 0 ? image.depth_m[i] : std::numeric_limits<float>::quiet_NaN();
+    }
+    depth_stamps_ns.push_back(now.ns);
+    depth_.publish(std::move(m));
+  }
+
+ public:
+  std::vector<std::int64_t> depth_stamps_ns;
+
+ private:
+  runtime::Publisher<msgs::sensor_msgs::Image> depth_;
+  runtime::Publisher<msgs::sensor_msgs::JointState> joints_;
+  geometry::Mesh mesh_;
+  std::uint64_t tick_ = 0;
+};
+
+struct PoseRecord {
+  std::int64_t stamp_ns;
+  std::string frame;
+  Eigen::Isometry3d T;
+};
+
+Eigen::Isometry3d from_msg(const msgs::geometry_msgs::Pose& p) {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() =
+      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
+          .normalized()
+          .toRotationMatrix();
+  T.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
+  return T;
+}
+
+class TestMatchingRecorder final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    return {.type = "test_matching_recorder",
+            .description = "tests: records the matching component's outputs",
+            .parameters = {},
+            .publishes = {},
+            .subscribes = {
+                runtime::port<msgs::geometry_msgs::PoseStamped>("pose", "/object/pose"),
+                runtime::port<msgs::geometry_msgs::PoseStamped>("world", "/object/pose_world"),
+                runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match"),
+                runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing"),
+                runtime::port<msgs::sensor_msgs::PointCloud2>("cloud", "/object/scene_points")}};
+  }
+  explicit TestMatchingRecorder(ComponentContext& ctx) : Component(ctx) {
+    auto pose_cb = [](std::vector<PoseRecord>& out) {
+      return [&out](runtime::SamplePtr<msgs::geometry_msgs::PoseStamped> m) {
+        out.push_back({runtime::from_ros_time(m->header.stamp).ns,
+                       std::string(runtime::get_string(m->header.frame_id)), from_msg(m->pose)});
+      };
+    };
+    ctx.subscribe<msgs::geometry_msgs::PoseStamped>("pose", pose_cb(camera));
+    ctx.subscribe<msgs::geometry_msgs::PoseStamped>("world", pose_cb(world));
+    ctx.subscribe<msgs::avs_msgs::MatchResult>(
+        "match", [this](runtime::SamplePtr<msgs::avs_msgs::MatchResult> m) { match.push_back(m); });
+    ctx.subscribe<msgs::avs_msgs::StageTiming>(
+        "timing", [this](runtime::SamplePtr<msgs::avs_msgs::StageTiming> m) {
+          if (runtime::get_string(m->stage) == "matching") ++timings;
+        });
+    ctx.subscribe<msgs::sensor_msgs::PointCloud2>(
+        "cloud", [this](runtime::SamplePtr<msgs::sensor_msgs::PointCloud2> m) {
+          clouds.push_back(m->width);
+        });
+  }
+  std::vector<PoseRecord> camera, world;
+  std::vector<runtime::SamplePtr<msgs::avs_msgs::MatchResult>> match;
+  std::vector<std::uint32_t> clouds;
+  int timings = 0;
+};
+
+AVS_REGISTER_COMPONENT(TestMatchingSource);
+AVS_REGISTER_COMPONENT(TestMatchingRecorder);
+
+struct GraphRun {
+  std::unique_ptr<graph::Graph> graph;
+  std::unique_ptr<runtime::Container> container;
+  TestMatchingSource* source = nullptr;
+  TestMatchingRecorder* recorder = nullptr;
+};
+
+GraphRun run_graph(int domain, double duration_s, const std::string& matching_params) {
+  setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
+  const auto dir =
+      std::filesystem::temp_directory_path() /
+      ("avs_matching_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "graph.yaml").string();
+  {
+    std::ofstream out(file);
+    out << "domain_id: " << domain << "\n"
+        << "clock: {source: sim, mode: lockstep, duration_s: " << duration_s << "}\n"
+        << "containers:\n"
+        << "  - name: matching\n"
+        << "    executor: single_threaded\n"
+        << "    components:\n"
+        << "      - {type: test_matching_source, name: source}\n"
+        << "      - {type: matching, name: matching, parameters: " << matching_params << "}\n"
+        << "      - {type: test_matching_recorder, name: recorder}\n";
+  }
+  graph::LoadResult loaded = graph::load_graph(file, {});
+  std::filesystem::remove_all(dir);
+  for (const auto& e : loaded.errors) ADD_FAILURE() << e.str();
+  GraphRun run;
+  if (!loaded.ok()) return run;
+  run.graph = std::make_unique<graph::Graph>(std::move(*loaded.graph));
+  run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
+  EXPECT_EQ(run.container->run(), 0);
+  run.source = dynamic_cast<TestMatchingSource*>(run.container->find_component("source"));
+  run.recorder = dynamic_cast<TestMatchingRecorder*>(run.container->find_component("recorder"));
+  EXPECT_NE(run.source, nullptr);
+  EXPECT_NE(run.recorder, nullptr);
+  return run;
+}
+
+double rotation_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  return Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle() * 180.0 / M_PI;
+}
+
+TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
+  GraphRun run = run_graph(150, 0.4, "{model: ken, publish_scene_points: true}");
+  ASSERT_NE(run.recorder, nullptr);
+  const auto& depth = run.source->depth_stamps_ns;
+  const auto& rec = *run.recorder;
+  ASSERT_GE(depth.size(), 190u);  // 0.4 s at 500 Hz
+
+  // One match result, one timing, one cloud per depth image; stamps are the images'.
+  ASSERT_EQ(rec.match.size(), depth.size());
+  EXPECT_EQ(rec.timings, static_cast<int>(depth.size()));
+  EXPECT_EQ(rec.clouds.size(), depth.size());
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    EXPECT_EQ(runtime::from_ros_time(rec.match[i]->header.stamp).ns, depth[i]);
+  }
+  EXPECT_EQ(rec.match.front()->state, avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING)
+      << "the first image initialises and tracks";
+
+  // A pose per depth image, camera and world, stamped like the image.
+  ASSERT_EQ(rec.camera.size(), depth.size());
+  ASSERT_EQ(rec.world.size(), depth.size());
+  double max_cam_mm = 0, max_world_mm = 0, max_deg = 0, sum_world = 0, sum_deg = 0;
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    const double t = static_cast<double>(depth[i]) * 1e-9;
+    EXPECT_EQ(rec.camera[i].stamp_ns, depth[i]);
+    EXPECT_EQ(rec.world[i].stamp_ns, depth[i]);
+    EXPECT_EQ(rec.camera[i].frame, "camera");
+    EXPECT_EQ(rec.world[i].frame, "world");
+    if (i > 0) {
+      EXPECT_EQ(depth[i] - depth[i - 1], 2000000) << "500 Hz";
+    }
+    const Eigen::Isometry3d truth_world = T_world_ken(t);
+    const Eigen::Isometry3d truth_camera =
+        geometry::T_world_camera(head_config(), pan_at(t), kTilt).inverse() * truth_world;
+    const double cam_mm = 1e3 * (rec.camera[i].T.translation() - truth_camera.translation()).norm();
+    const double world_mm = 1e3 * (rec.world[i].T.translation() - truth_world.translation()).norm();
+    max_cam_mm = std::max(max_cam_mm, cam_mm);
+    max_world_mm = std::max(max_world_mm, world_mm);
+    sum_world += world_mm * world_mm;
+    const double deg = rotation_deg(rec.world[i].T, truth_world);
+    max_deg = std::max(max_deg, deg);
+    sum_deg += deg * deg;
+  }
+  std::printf(
+      "%zu depth images, %zu poses; camera frame max %.2f mm, world max %.2f mm (RMS %.2f), "
+      "max %.2f deg (RMS %.2f)\n",
+      depth.size(), rec.camera.size(), max_cam_mm, max_world_mm,
+      std::sqrt(sum_world / static_cast<double>(depth.size())), max_deg,
+      std::sqrt(sum_deg / static_cast<double>(depth.size())));
+  // Noise-free rendering: the residual is the sparse model's bias (docs/matching.md).
+  EXPECT_LT(max_cam_mm, 4.0);
+  EXPECT_LT(max_world_mm, 4.0);  // the head moves up to 1.3 rad/s: kinematics + interpolation
+  EXPECT_LT(max_deg, 5.0);
+  EXPECT_LT(std::sqrt(sum_deg / static_cast<double>(depth.size())), 2.0);
+}
+
+TEST(MatchingComponent, WithoutJointStatesOnlyTheCameraPoseIsPublished) {
+  GraphRun run = run_graph(151, 0.05,
+                           "{model: ken, joint_names: 'yaw,pitch'}");  // no such joints
+  ASSERT_NE(run.recorder, nullptr);
+  EXPECT_EQ(run.recorder->camera.size(), run.source->depth_stamps_ns.size());
+  EXPECT_TRUE(run.recorder->world.empty());
+  EXPECT_TRUE(run.recorder->clouds.empty()) << "scene points are off by default";
+}
+
+TEST(MatchingComponent, UnknownModelFailsTheContainerLoudly) {
+  setenv("AVS_DOMAIN_ID", "152", 1);
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("avs_matching_bad_" + std::to_string(getpid()) + ".yaml");
+  {
+    std::ofstream out(file);
+    out << "domain_id: 152\nclock: {source: sim, mode: lockstep, duration_s: 0.01}\n"
+        << "containers:\n  - name: m\n    components:\n"
+        << "      - {type: matching, name: matching, parameters: {model: /nonexistent.ply}}\n";
+  }
+  graph::LoadResult loaded = graph::load_graph(file.string(), {});
+  std::filesystem::remove(file);
+  ASSERT_TRUE(loaded.ok());
+  runtime::Container container(*loaded.graph, loaded.graph->containers.front());
+  EXPECT_NE(container.run(), 0);
+}
+
+}  // namespace
+}  // namespace avs::matching
