@@ -42,6 +42,7 @@ struct BenchArgs {
   std::vector<std::string> compressions{"none", "lz4", "zstd"};
   bool keep = false;
   int domain = -1;
+  int history = 0;  // publisher KEEP_LAST depth; 0 = KEEP_ALL
 };
 
 /// Options as `--key=value` (`avs bench` hands unknown options and positional words over
@@ -76,6 +77,8 @@ BenchArgs parse_args(const std::vector<std::string>& raw) {
       a.role = value();
     } else if (k == "--dir") {
       a.dir = value();
+    } else if (k == "--publisher-history") {
+      a.history = std::stoi(value());
     } else if (k == "--keep") {
       a.keep = true;
     } else if (k == "--domain") {
@@ -87,13 +90,14 @@ BenchArgs parse_args(const std::vector<std::string>& raw) {
     } else if (k == "--help" || k == "-h") {
       std::printf(
           "avs bench bag [--duration=S] [--fps=N] [--size=PX] [--compression=none,lz4,zstd]\n"
-          "              [--dir=DIR] [--keep] [--domain=ID]\n"
+          "              [--dir=DIR] [--keep] [--domain=ID] [--publisher-history=N]\n"
           "Records /bench_bag/pattern_frames (avs_msgs/PatternFrame, PXxPX mono8, N fps) with\n"
           "/bench_bag/target (1 kHz), /bench_bag/torque (1 kHz) and /bench_bag/match (100 Hz) from "
           "a\n"
           "publisher process for S seconds per compression; files go to DIR (default $TMPDIR or "
           "/tmp)\n"
-          "and are deleted unless --keep.\n");
+          "and are deleted unless --keep. The publisher is reliable KEEP_ALL, or KEEP_LAST N with\n"
+          "--publisher-history=N (to show the losses a reader is not told about).\n");
       std::exit(0);
     } else {
       throw runtime::Error("avs bench bag: unknown argument " + k + " (see --help)");
@@ -159,7 +163,8 @@ class BenchWriter {
   // KEEP_LAST writer drops unacknowledged samples from its history when it runs ahead, and
   // Cyclone 0.10's reader is not told (no SAMPLE_LOST): docs/bag.md, loss accounting.
   runtime::dds::EndpointQos qos;
-  qos.keep_all = true;
+  qos.keep_all = a.history <= 0;
+  qos.depth = a.history;
   const runtime::QosProfile topic_qos;
   runtime::dds::Topic frames_t(participant, &avs_msgs_msg_dds__PatternFrame__desc,
                                "rt/bench_bag/pattern_frames", topic_qos);
@@ -315,7 +320,8 @@ Run run_one(const BenchArgs& a, const std::string& compression, const std::files
                                     "--duration=" + std::to_string(a.duration_s),
                                     "--fps=" + std::to_string(a.fps),
                                     "--size=" + std::to_string(a.width),
-                                    "--domain=" + std::to_string(a.domain)};
+                                    "--domain=" + std::to_string(a.domain),
+                                    "--publisher-history=" + std::to_string(a.history)};
   std::vector<char*> argv;
   for (auto& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
@@ -444,7 +450,8 @@ bench::Report run_bench(const std::vector<std::string>& args) {
   }
   report.notes.push_back(
       "No peer: rosbag2 is not installed on this machine; the publisher is a second process "
-      "(reliable, keep all).");
+      "(reliable, " +
+      (a.history > 0 ? "keep last " + std::to_string(a.history) : std::string("keep all")) + ").");
   return report;
 }
 
