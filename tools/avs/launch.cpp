@@ -2,6 +2,9 @@
 // (`avs container FILE --name C ...`), forwards Ctrl-C and SIGTERM, reports a container
 // that dies with its exit status, applies each container's respawn policy, and returns
 // non-zero if any container failed.
+// With a deployment file (docs/deploy.md) and --host NAME it starts that host's containers
+// with the Cyclone configuration generated for the host, and reports when a topic its
+// containers read from other hosts loses its last publisher, and when one comes back.
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,16 +14,30 @@
 #include <ctime>
 #include <iostream>
 #include <map>
+#include <memory>
+#include <set>
 
+#include "avs/deploy/deployment.hpp"
+#include "avs/deploy/publisher_watch.hpp"
+#include "avs/runtime/component.hpp"
 #include "commands.hpp"
 #include "graph_loading.hpp"
+
+extern char** environ;
 
 namespace avs::cli {
 
 namespace {
 
+/// What to run for one container: the full command line and environment.
+struct ChildPlan {
+  std::vector<std::string> argv;
+  std::vector<std::string> env;
+};
+
 struct Child {
   const graph::ContainerSpec* spec = nullptr;
+  ChildPlan plan;
   pid_t pid = -1;
   int restarts = 0;
   double backoff_s = 0;
@@ -35,22 +52,48 @@ double monotonic_s() {
   return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
 }
 
-pid_t spawn(const std::string& file, const std::string& container,
-            const std::vector<std::string>& words, const sigset_t& original_mask) {
+pid_t spawn(const ChildPlan& plan, const sigset_t& original_mask) {
+  // Everything the child needs is built before fork(): the launcher may have DDS threads.
+  std::vector<std::string> argv_s = plan.argv;
+  std::vector<std::string> env_s = plan.env;
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<char*> envp;
+  for (auto& e : env_s) envp.push_back(e.data());
+  envp.push_back(nullptr);
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (pid == 0) {
     sigprocmask(SIG_SETMASK, &original_mask, nullptr);
-    std::vector<std::string> argv_s = {"avs", "container", file, "--name", container};
-    argv_s.insert(argv_s.end(), words.begin(), words.end());
-    std::vector<char*> argv;
-    for (auto& s : argv_s) argv.push_back(s.data());
-    argv.push_back(nullptr);
-    execv("/proc/self/exe", argv.data());
-    std::cerr << "avs launch: exec failed: " << std::strerror(errno) << "\n";
+    execve("/proc/self/exe", argv.data(), envp.data());
+    static const char msg[] = "avs launch: exec of /proc/self/exe failed\n";
+    [[maybe_unused]] const auto n = write(2, msg, sizeof msg - 1);
     _exit(127);
   }
   return pid;
+}
+
+std::vector<std::string> current_environment() {
+  std::vector<std::string> env;
+  for (char** e = environ; e != nullptr && *e != nullptr; ++e) env.emplace_back(*e);
+  return env;
+}
+
+/// `env` with NAME=value set (replacing an existing NAME).
+void set_env(std::vector<std::string>& env, const std::string& name, const std::string& value) {
+  const std::string prefix = name + "=";
+  std::erase_if(env, [&](const std::string& e) { return e.rfind(prefix, 0) == 0; });
+  env.push_back(prefix + value);
+}
+
+ChildPlan container_plan(const std::string& file, const std::string& container,
+                         const std::vector<std::string>& words) {
+  ChildPlan plan;
+  plan.argv = {"avs", "container", file, "--name", container};
+  plan.argv.insert(plan.argv.end(), words.begin(), words.end());
+  plan.env = current_environment();
+  return plan;
 }
 
 std::string describe_status(int status) {
@@ -59,33 +102,15 @@ std::string describe_status(int status) {
   return "stopped";
 }
 
-int run_launch(const std::string& file, const std::vector<std::string>& words,
-               const std::string& host) {
-  auto g = load_or_report(file, words);
-  if (!g) return 2;
-
-  sigset_t handled, original;
-  sigemptyset(&handled);
-  sigaddset(&handled, SIGINT);
-  sigaddset(&handled, SIGTERM);
-  sigaddset(&handled, SIGCHLD);
-  sigprocmask(SIG_BLOCK, &handled, &original);
-
+/// Runs `children` until all ended (or Ctrl-C / SIGTERM); applies respawn policies.
+int supervise(std::vector<Child>& children, const sigset_t& handled, const sigset_t& original) {
   std::map<pid_t, Child*> by_pid;
-  std::vector<Child> children;
-  for (const auto& c : g->containers) {
-    if (!host.empty() && !c.host.empty() && c.host != host) continue;
-    children.push_back(Child{&c});
-  }
-  if (children.empty()) {
-    std::cerr << "avs launch: no container to start" << (host.empty() ? "" : " on host " + host) << "\n";
-    return 2;
-  }
   for (auto& child : children) {
-    child.pid = spawn(file, child.spec->name, words, original);
+    child.pid = spawn(child.plan, original);
     child.backoff_s = child.spec->respawn.backoff_s;
     by_pid[child.pid] = &child;
-    std::cerr << "avs launch: started container '" << child.spec->name << "' (pid " << child.pid << ")\n";
+    std::cerr << "avs launch: started container '" << child.spec->name << "' (pid " << child.pid
+              << ")\n";
   }
 
   bool stopping = false;
@@ -124,11 +149,12 @@ int run_launch(const std::string& file, const std::vector<std::string>& words,
       by_pid.erase(it);
       c.pid = -1;
       const bool failed = !(WIFEXITED(status) && WEXITSTATUS(status) == 0);
-      std::cerr << "avs launch: container '" << c.spec->name << "' " << describe_status(status) << "\n";
+      std::cerr << "avs launch: container '" << c.spec->name << "' " << describe_status(status)
+                << "\n";
       using Kind = graph::RespawnPolicy::Kind;
       const auto& policy = c.spec->respawn;
-      const bool respawn = !stopping && (policy.kind == Kind::always ||
-                                         (policy.kind == Kind::on_failure && failed));
+      const bool respawn =
+          !stopping && (policy.kind == Kind::always || (policy.kind == Kind::on_failure && failed));
       if (respawn && c.restarts < policy.max_restarts) {
         c.restart_at = now + c.backoff_s;
         std::cerr << "avs launch: restarting '" << c.spec->name << "' in " << c.backoff_s
@@ -145,8 +171,10 @@ int run_launch(const std::string& file, const std::vector<std::string>& words,
       if (c.restart_at >= 0 && now >= c.restart_at && !stopping) {
         c.restart_at = -1;
         ++c.restarts;
-        c.pid = spawn(file, c.spec->name, words, original);
+        c.pid = spawn(c.plan, original);
         by_pid[c.pid] = &c;
+        std::cerr << "avs launch: restarted container '" << c.spec->name << "' (pid " << c.pid
+                  << ")\n";
       }
     }
     if (stopping && kill_at >= 0 && now > kill_at) {
@@ -159,8 +187,156 @@ int run_launch(const std::string& file, const std::vector<std::string>& words,
       kill_at = -1;
     }
   }
-  sigprocmask(SIG_SETMASK, &original, nullptr);
   return result;
+}
+
+/// Blocks the signals the supervisor waits for; restores the mask when it ends.
+struct SignalScope {
+  sigset_t handled{}, original{};
+  SignalScope() {
+    sigemptyset(&handled);
+    sigaddset(&handled, SIGINT);
+    sigaddset(&handled, SIGTERM);
+    sigaddset(&handled, SIGCHLD);
+    sigprocmask(SIG_BLOCK, &handled, &original);
+  }
+  ~SignalScope() { sigprocmask(SIG_SETMASK, &original, nullptr); }
+  SignalScope(const SignalScope&) = delete;
+  SignalScope& operator=(const SignalScope&) = delete;
+};
+
+int run_graph(const std::string& file, const std::vector<std::string>& words,
+              const std::string& host) {
+  auto g = load_or_report(file, words);
+  if (!g) return 2;
+  std::vector<Child> children;
+  for (const auto& c : g->containers) {
+    if (!host.empty() && !c.host.empty() && c.host != host) continue;
+    children.push_back(Child{&c, container_plan(file, c.name, words)});
+  }
+  if (children.empty()) {
+    std::cerr << "avs launch: no container to start" << (host.empty() ? "" : " on host " + host)
+              << "\n";
+    return 2;
+  }
+  SignalScope signals;
+  return supervise(children, signals.handled, signals.original);
+}
+
+/// Topics read by `host`'s containers whose every publisher runs on another host: these are
+/// the ones whose loss the launcher reports. topic (DDS name) -> "container 'x' on host 'A'".
+std::map<std::string, std::string> remote_inputs(const deploy::Deployment& d,
+                                                 const deploy::Host& host) {
+  struct Ends {
+    std::set<std::string> local_pub, remote_pub;
+    bool read_here = false;
+  };
+  std::map<std::string, Ends> topics;
+  const auto& registry = runtime::ComponentRegistry::instance();
+  for (const auto& c : d.graph.containers) {
+    const deploy::Host* h = d.host_of(c.name);
+    const bool here = h == &host;
+    for (const auto& comp : c.components) {
+      const runtime::RegisteredComponent* reg = registry.find(comp.type);
+      if (reg == nullptr) continue;
+      for (const auto& p : reg->spec.publishes) {
+        auto& e = topics["rt" + graph::port_topic(d.graph, comp, p)];
+        (here ? e.local_pub : e.remote_pub)
+            .insert("container '" + c.name + "' on host '" + (h ? h->name : "?") + "'");
+      }
+      if (here) {
+        for (const auto& p : reg->spec.subscribes) {
+          topics["rt" + graph::port_topic(d.graph, comp, p)].read_here = true;
+        }
+      }
+    }
+  }
+  std::map<std::string, std::string> out;
+  for (const auto& [topic, e] : topics) {
+    if (!e.read_here || !e.local_pub.empty() || e.remote_pub.empty()) continue;
+    std::string from;
+    for (const auto& p : e.remote_pub) from += (from.empty() ? "" : ", ") + p;
+    out[topic] = from;
+  }
+  return out;
+}
+
+int run_deployment(const std::string& file, const std::vector<std::string>& words,
+                   const std::string& host_name) {
+  std::vector<std::string> rest;
+  const auto overrides = graph::parse_arg_overrides(words, &rest);
+  if (!rest.empty()) {
+    std::cerr << "avs: unexpected argument '" << rest.front() << "' (arguments are NAME:=VALUE)\n";
+    return 2;
+  }
+  deploy::LoadResult loaded = deploy::load_deployment(file, overrides);
+  for (const auto& e : loaded.errors) std::cerr << e.str() << "\n";
+  if (!loaded.ok()) return 2;
+  const deploy::Deployment& d = *loaded.deployment;
+  std::string hosts;
+  for (const auto& h : d.host_names()) hosts += (hosts.empty() ? "'" : ", '") + h + "'";
+  if (host_name.empty() && d.hosts.size() > 1) {
+    std::cerr << "avs launch: " << file << " is a deployment over several hosts; say which one "
+              << "this is with --host NAME (hosts: " << hosts << ")\n";
+    return 2;
+  }
+  const deploy::Host* host = host_name.empty() ? &d.hosts.front() : d.find_host(host_name);
+  if (host == nullptr) {
+    std::cerr << "avs launch: " << file << " has no host '" << host_name << "' (hosts: " << hosts
+              << ")\n";
+    return 2;
+  }
+  if (host->containers.empty()) {
+    std::cerr << "avs launch: host '" << host->name << "' runs no container\n";
+    return 2;
+  }
+  std::vector<std::string> graph_words;
+  for (const auto& [k, v] : d.graph_args) graph_words.push_back(k + ":=" + v);
+  std::vector<Child> children;
+  for (const auto& name : host->containers) {
+    Child child{d.graph.find_container(name), container_plan(d.graph_file, name, graph_words)};
+    set_env(child.plan.env, "CYCLONEDDS_URI", deploy::cyclone_config(d, *host, name));
+    set_env(child.plan.env, "AVS_DOMAIN_ID", std::to_string(d.domain_id));
+    set_env(child.plan.env, "AVS_HOST", host->name);
+    if (!d.partition.empty()) set_env(child.plan.env, "AVS_PARTITION", d.partition);
+    children.push_back(std::move(child));
+  }
+  std::cerr << "avs launch: host '" << host->name << "' of " << file << ": domain " << d.domain_id
+            << (d.partition.empty() ? "" : ", partition '" + d.partition + "'")
+            << (d.discovery.multicast ? ", multicast discovery" : ", unicast peers")
+            << (d.security.enabled ? ", DDS security on" : "") << "\n";
+
+  SignalScope signals;  // before the watch's threads start, so they inherit the mask
+  const auto inputs = remote_inputs(d, *host);
+  std::unique_ptr<deploy::PublisherWatch> watch;
+  if (!inputs.empty()) {
+    std::vector<std::string> topics;
+    for (const auto& [t, from] : inputs) topics.push_back(t);
+    const std::string prefix = "avs launch [" + host->name + "]: ";
+    try {
+      watch = std::make_unique<deploy::PublisherWatch>(
+          d.domain_id, deploy::cyclone_config(d, *host, "observer"), topics,
+          [prefix, inputs](const deploy::PublisherWatch::Event& e) {
+            const std::string ros = e.topic.substr(2);
+            if (e.lost) {
+              std::cerr << prefix << "LOST publisher of " << ros << " (from " << inputs.at(e.topic)
+                        << "): no live writer\n";
+            } else {
+              std::cerr << prefix << "publisher of " << ros << " alive (" << e.live_writers
+                        << " writer(s))\n";
+            }
+          });
+    } catch (const std::exception& e) {
+      std::cerr << "avs launch: cannot watch remote publishers: " << e.what() << "\n";
+    }
+  }
+  return supervise(children, signals.handled, signals.original);
+}
+
+int run_launch(const std::string& file, const std::vector<std::string>& words,
+               const std::string& host) {
+  if (deploy::is_deployment_file(file)) return run_deployment(file, words, host);
+  return run_graph(file, words, host);
 }
 
 }  // namespace
@@ -175,9 +351,13 @@ void add_launch_command(CLI::App& app) {
   static std::string file;
   static std::string host;
   static std::vector<std::string> words;
-  cmd->add_option("file", file, "graph YAML file (see docs/graphs.md)")->required();
+  cmd->add_option("file", file,
+                  "graph YAML file (docs/graphs.md) or deployment YAML (docs/deploy.md)")
+      ->required();
   cmd->add_option("args", words, "argument overrides NAME:=VALUE");
-  cmd->add_option("--host", host, "start only the containers placed on this host");
+  cmd->add_option("--host", host,
+                  "start only the containers placed on this host (required for a deployment "
+                  "over several hosts)");
   cmd->callback([] { exit_status() = run_launch(file, words, host); });
 }
 
