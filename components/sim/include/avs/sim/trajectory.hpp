@@ -110,6 +110,7 @@ class LateralSwingTrajectory final : public Trajectory {
   explicit LateralSwingTrajectory(LateralSwingConfig config);
   Eigen::Isometry3d T_world_object(double t_s) const override;
   double frequency_hz() const { return frequency_hz_; }
+  const LateralSwingConfig& config() const { return config_; }
 
  private:
   LateralSwingConfig config_;
