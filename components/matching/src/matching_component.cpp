@@ -120,9 +120,11 @@ class MatchingComponent final : public runtime::Component {
                              "drop S-PCD points whose mean neighbour distance is larger"),
              ParamSpec::real_list("icp_iterations", {0, 0, 1}, "",
                                   "[n1, n2, n3] per frame on 1/4, 1/2, all scene points"),
-             ParamSpec::string("icp_metric", "point_to_plane", "per-frame ICP metric",
-                               {"point_to_plane", "point_to_point"}),
-             ParamSpec::real("max_rmse_m", 0.01, 0.0, 1.0, "m",
+             ParamSpec::string("icp_metric", "auto",
+                               "per-frame ICP metric; auto = point_to_point for the cylinder "
+                               "(point-to-plane slides along its axis), else point_to_plane",
+                               {"auto", "point_to_plane", "point_to_point"}),
+             ParamSpec::real("max_rmse_m", 0.015, 0.0, 1.0, "m",
                              "a frame fails above this ICP RMSE (0 = model's mean spacing)"),
              ParamSpec::real("min_inlier_ratio", 0.3, 0.0, 1.0, "",
                              "a frame fails below this inlier ratio"),
@@ -211,9 +213,10 @@ class MatchingComponent final : public runtime::Component {
         throw std::invalid_argument("parameter 'icp_iterations': expected integers in [0, 1000]");
       config.tracker.icp.iterations[k] = static_cast<int>(iterations[k]);
     }
-    config.tracker.icp.metric = ctx.param<std::string>("icp_metric") == "point_to_point"
-                                    ? IcpMetric::point_to_point
-                                    : IcpMetric::point_to_plane;
+    const std::string metric = ctx.param<std::string>("icp_metric");
+    config.tracker.icp.metric = metric == "auto"             ? object.metric
+                                : metric == "point_to_point" ? IcpMetric::point_to_point
+                                                             : IcpMetric::point_to_plane;
     config.tracker.max_rmse_m = static_cast<float>(ctx.param<double>("max_rmse_m"));
     config.tracker.min_inlier_ratio = static_cast<float>(ctx.param<double>("min_inlier_ratio"));
     config.tracker.failures_before_loss =

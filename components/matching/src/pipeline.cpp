@@ -20,7 +20,8 @@ SceneCloudConfig scene_config(const PipelineConfig& config, const ModelCloud& mo
 /// pose moved forward by dt_s at the motion that took `older` (at t_older) to `newer` (at
 /// t_newer): constant linear and angular velocity in the camera frame.
 Eigen::Isometry3f extrapolate(const Eigen::Isometry3f& older, double t_older,
-                              const Eigen::Isometry3f& newer, double t_newer, double dt_s) {
+                              const Eigen::Isometry3f& newer, double t_newer, double dt_s,
+                              bool rotate) {
   if (!(t_newer > t_older)) return newer;
   const double scale = dt_s / (t_newer - t_older);
   const Eigen::Isometry3f delta = newer * older.inverse();  // older -> newer, camera frame
@@ -31,7 +32,7 @@ Eigen::Isometry3f extrapolate(const Eigen::Isometry3f& older, double t_older,
   // Rotate about the object's origin, translate its origin at the mean velocity.
   const Eigen::Vector3f v = (newer.translation() - older.translation()) * static_cast<float>(scale);
   Eigen::Isometry3f out = Eigen::Isometry3f::Identity();
-  out.linear() = r * newer.linear();
+  out.linear() = rotate ? Eigen::Matrix3f(r * newer.linear()) : newer.linear();
   out.translation() = newer.translation() + v;
   return out;
 }
@@ -78,8 +79,9 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s)
   if (config_.lag_compensation_s > 0.0 && out.has_pose && history_.size() >= 2) {
     const Stamped& older = history_.front();
     const Stamped& newer = history_.back();
-    out.T_camera_model = extrapolate(older.T_camera_model, older.stamp_s, newer.T_camera_model,
-                                     newer.stamp_s, config_.lag_compensation_s);
+    out.T_camera_model =
+        extrapolate(older.T_camera_model, older.stamp_s, newer.T_camera_model, newer.stamp_s,
+                    config_.lag_compensation_s, config_.lag_compensate_rotation);
     out.lag_compensated = true;
   }
   out.processing_ms =
@@ -114,6 +116,7 @@ ObjectModel load_object_model(const std::string& name_or_path, const std::string
     object.model_points = preset.model_points;
     object.scene_points = preset.scene_points;
     object.symmetry = preset.symmetry;
+    if (preset.symmetry == Symmetry::cylinder_z) object.metric = IcpMetric::point_to_point;
     object.mesh_path =
         (models_dir.empty() ? default_models_dir() : models_dir) + "/" + preset.name + ".ply";
   }

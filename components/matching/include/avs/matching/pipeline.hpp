@@ -33,6 +33,8 @@ struct PipelineConfig {
   /// The velocity is the mean motion over the valid tracked poses of the last this many
   /// seconds (one frame-to-frame difference is too noisy to extrapolate by).
   double velocity_window_s = 0.01;
+  /// Also extrapolate the orientation (the angular velocity of a few tracked poses is noisy).
+  bool lag_compensate_rotation = false;
 };
 
 /// Per-frame result of MatchingPipeline::process().
@@ -83,6 +85,9 @@ struct ObjectModel {
   std::size_t model_points = 0;
   std::size_t scene_points = 0;
   Symmetry symmetry = Symmetry::none;
+  /// Per-frame ICP metric that suits the object: point-to-point for a cylinder (point-to-plane
+  /// lets it slide along its axis when the caps are barely seen), point-to-plane otherwise.
+  IcpMetric metric = IcpMetric::point_to_plane;
 };
 
 /// "ken", "cube", "cylinder": the shipped models/<name>.ply with the paper's sizes (section 7.2:
