@@ -19,6 +19,7 @@
 
 #include "avs/deploy/deployment.hpp"
 #include "avs/deploy/publisher_watch.hpp"
+#include "avs/deploy/roudi.hpp"
 #include "avs/runtime/component.hpp"
 #include "commands.hpp"
 #include "graph_loading.hpp"
@@ -307,6 +308,16 @@ int run_deployment(const std::string& file, const std::vector<std::string>& word
             << (d.security.enabled ? ", DDS security on" : "") << "\n";
 
   SignalScope signals;  // before the watch's threads start, so they inherit the mask
+  std::unique_ptr<deploy::Roudi> roudi;  // shared memory: RouDi before every participant
+  if (d.shared_memory.enabled) {
+    try {
+      roudi = std::make_unique<deploy::Roudi>();
+      std::cerr << "avs launch: shared memory through " << roudi->description() << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "avs launch: " << e.what() << "\n";
+      return 2;
+    }
+  }
   const auto inputs = remote_inputs(d, *host);
   std::unique_ptr<deploy::PublisherWatch> watch;
   if (!inputs.empty()) {
