@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -195,9 +196,26 @@ OpenCvTiming time_opencv(const SensorGeometry& g, const SyntheticScene& scene, i
 
 bench::Report run(const std::vector<std::string>& args) {
   int updates = 300, opencv_runs = 5;
-  for (std::size_t i = 0; i + 1 < args.size(); ++i) {
-    if (args[i] == "--updates") updates = std::stoi(args[i + 1]);
-    if (args[i] == "--opencv-runs") opencv_runs = std::stoi(args[i + 1]);
+  // --updates N / --updates=N, --opencv-runs N / --opencv-runs=N.
+  const auto number = [](const std::string& option, const std::string& text) {
+    try {
+      std::size_t used = 0;
+      const int value = std::stoi(text, &used);
+      if (used == text.size() && value > 0) return value;
+    } catch (const std::exception&) {
+    }
+    throw std::invalid_argument("bench decode: " + option + " needs a positive integer, got '" +
+                                text + "' (write " + option + "=N)");
+  };
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    for (const std::string option : {"--updates", "--opencv-runs"}) {
+      int* target = option == "--updates" ? &updates : &opencv_runs;
+      if (args[i].rfind(option + "=", 0) == 0) {
+        *target = number(option, args[i].substr(option.size() + 1));
+      } else if (args[i] == option) {
+        *target = number(option, i + 1 < args.size() ? args[i + 1] : std::string());
+      }
+    }
   }
   DecoderConfig config;
   PlaneSceneConfig scene_config;
