@@ -1,46 +1,55 @@
-// avs demo: the main job. The simulated closed loop (projector-camera, active tracking,
-// matching; issues 3-6 and 9) is not assembled yet: until it is, this runs the richest
-// example graph for a few seconds and prints what its components saw — and says so.
-#include <unistd.h>
-
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
+// avs demo: the main job. The simulated closed loop of the paper (projector-camera with
+// Gray-code depth at 500 Hz, active tracking by the pan/tilt head, model matching of the
+// kendama's ken on the manipulator trajectory) in sim-time lockstep, with progress, the
+// results table beside the paper's figures, and the report folder (figures, index.html).
+#include <ctime>
 #include <iostream>
 
+#include "avs/report/report.hpp"
+#include "closed_loop.hpp"
 #include "commands.hpp"
 
 namespace avs::cli {
 
+namespace {
+
+std::filesystem::path default_run_dir(const std::string& name) {
+  char stamp[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return std::filesystem::path("avs-runs") / (name + "-" + stamp);
+}
+
+}  // namespace
+
 void add_demo_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("demo", "Run the main job (see README)");
-  static double seconds = 3.0;
-  static std::string graph = std::string(AVS_SOURCE_DIR) + "/launch_config/talker_listener.yaml";
-  cmd->add_option("--seconds", seconds, "how long to run")->capture_default_str();
-  cmd->add_option("--graph", graph, "graph to run")->capture_default_str();
+  auto* cmd = app.add_subcommand(
+      "demo",
+      "Run the simulated closed loop (depth at 500 Hz, active tracking, model matching of the "
+      "ken on the manipulator trajectory) and report it beside the paper's figures");
+  static ClosedLoopRun run;
+  static std::string out;
+  static bool no_tracking = false;
+  cmd->add_option("--seconds", run.duration_s, "simulated time to run")->capture_default_str();
+  cmd->add_option("--out", out, "run folder (default avs-runs/demo-<date>)");
+  cmd->add_option("--scene", run.scene, "scene: a name in launch_config/scenes/ or a YAML file")
+      ->capture_default_str();
+  cmd->add_option("--object", run.object, "model to match: ken, cube, cylinder or a mesh file")
+      ->capture_default_str();
+  cmd->add_option("--symmetry", run.symmetry, "object symmetry: none, cube, cylinder_x|y|z")
+      ->capture_default_str();
+  cmd->add_flag("--no-tracking", no_tracking, "the head holds still (Sec. 7.1.2)");
   cmd->callback([] {
-    std::cerr << "avs demo: NOT YET the closed-loop demo (simulated projector-camera, tracking and\n"
-                 "matching are still being built); running the runtime example graph "
-              << graph << " for " << seconds << " s instead.\n";
-    const std::filesystem::path dir =
-        std::filesystem::temp_directory_path() / ("avs-demo-" + std::to_string(getpid()));
-    std::filesystem::create_directories(dir);
-    const int status = launch_graph(
-        graph, {"duration_s:=" + std::to_string(seconds), "report_dir:=" + dir.string()}, "");
-    std::printf("\n%-20s %10s %14s\n", "listener", "received", "same buffer");
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-      std::ifstream in(entry.path());
-      std::string key;
-      long received = 0, same = 0;
-      while (in >> key) {
-        if (key == "received:") in >> received;
-        else if (key == "same_buffer:") in >> same;
-        else in.ignore(1 << 20, '\n');
-      }
-      std::printf("%-20s %10ld %14ld\n", entry.path().stem().c_str(), received, same);
-    }
-    std::printf("\nreports in %s\n", dir.c_str());
-    exit_status() = status;
+    run.scenario = "demo";
+    run.tracking = !no_tracking;
+    run.dir = out.empty() ? default_run_dir("demo") : std::filesystem::path(out);
+    std::cerr << "avs demo: simulated closed loop, " << run.duration_s << " s of sim time in "
+              << "lockstep (graph " << closed_loop_graph().string() << ", scene " << run.scene
+              << "); Ctrl-C ends it early with a partial report\n";
+    const ClosedLoopOutcome outcome = run_closed_loop(run, std::cerr);
+    if (outcome.interrupted) std::cerr << "avs demo: interrupted: partial report\n";
+    const int report_status = report::report_main(run.dir);
+    exit_status() = outcome.status != 0 ? outcome.status : report_status;
   });
 }
 

@@ -46,7 +46,8 @@ void add_check_command(CLI::App& app) {
 }
 
 void add_components_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("components", "List component types with their parameters and topics");
+  auto* cmd =
+      app.add_subcommand("components", "List component types with their parameters and topics");
   static std::string only;
   cmd->add_option("type", only, "show only this type");
   cmd->callback([] {
@@ -66,10 +67,12 @@ void add_components_command(CLI::App& app) {
         std::cout << "  " << p.description << "\n";
       }
       for (const auto& p : c->spec.publishes) {
-        std::cout << "  publishes " << p.name << " -> " << p.default_topic << " [" << p.dds_type << "]\n";
+        std::cout << "  publishes " << p.name << " -> " << p.default_topic << " [" << p.dds_type
+                  << "]\n";
       }
       for (const auto& p : c->spec.subscribes) {
-        std::cout << "  subscribes " << p.name << " <- " << p.default_topic << " [" << p.dds_type << "]\n";
+        std::cout << "  subscribes " << p.name << " <- " << p.default_topic << " [" << p.dds_type
+                  << "]\n";
       }
     }
     if (!found) {

@@ -11,8 +11,9 @@ int& exit_status() {
 }  // namespace avs::cli
 
 int main(int argc, char** argv) {
-  CLI::App app{"avs: active high-speed 3-D vision (Gray-code depth at 500 Hz, visual servoing, "
-               "model matching) as a graph of components over DDS"};
+  CLI::App app{
+      "avs: active high-speed 3-D vision (Gray-code depth at 500 Hz, visual servoing, "
+      "model matching) as a graph of components over DDS"};
   app.require_subcommand(1);
   avs::cli::add_demo_command(app);
   avs::cli::add_launch_command(app);

@@ -61,7 +61,9 @@ std::string describe_qos(const dds_qos_t* qos) {
 }
 
 volatile std::sig_atomic_t g_interrupted = 0;
-void on_interrupt(int) { g_interrupted = 1; }
+void on_interrupt(int) {
+  g_interrupted = 1;
+}
 
 /// Reads the built-in publication/subscription topics for `wait`, skipping our own.
 std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& participant,
@@ -93,7 +95,8 @@ std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& parti
       if (topic.rfind("DCPS", 0) == 0) continue;
       TopicInfo& info = topics[topic];
       info.type_name = ep->type_name;
-      (kind == 0 ? info.publishers : info.subscribers).push_back({ep->type_name, describe_qos(ep->qos)});
+      (kind == 0 ? info.publishers : info.subscribers)
+          .push_back({ep->type_name, describe_qos(ep->qos)});
     }
     dds_return_loan(reader, samples, n);
   }
@@ -126,7 +129,8 @@ class RawReader {
     const TopicInfo& info = topics.at(dds_name_);
     type_ = msg::find_type(info.type_name);
     if (type_ == nullptr) {
-      throw runtime::Error(dds_name_ + " has type " + info.type_name + ", which this build does not know");
+      throw runtime::Error(dds_name_ + " has type " + info.type_name +
+                           ", which this build does not know");
     }
     // Match what the publishers offer: reliable only if they all are.
     runtime::QosProfile qos;
@@ -139,7 +143,8 @@ class RawReader {
     reader_ = runtime::dds::Entity(runtime::check_dds(
         dds_create_reader(participant.get(), topic_->get(), reader_qos.get(), nullptr),
         "create reader on " + dds_name_));
-    waitset_ = runtime::dds::Entity(runtime::check_dds(dds_create_waitset(participant.get()), "waitset"));
+    waitset_ =
+        runtime::dds::Entity(runtime::check_dds(dds_create_waitset(participant.get()), "waitset"));
     condition_ = runtime::dds::Entity(runtime::check_dds(
         dds_create_readcondition(reader_.get(), DDS_ANY_STATE), "read condition"));
     runtime::check_dds(dds_waitset_attach(waitset_.get(), condition_.get(), 0), "attach");
@@ -184,7 +189,8 @@ struct CommonOptions {
 
 void add_common(CLI::App* cmd, CommonOptions& o, bool needs_topic) {
   if (needs_topic) cmd->add_option("topic", o.topic, "topic: /name, name or rt/name")->required();
-  cmd->add_option("--domain", o.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")->capture_default_str();
+  cmd->add_option("--domain", o.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")
+      ->capture_default_str();
   cmd->add_option("--wait", o.wait_s, "seconds to wait for a publisher")->capture_default_str();
   cmd->add_option("--duration", o.duration_s, "stop after this many seconds (0: until Ctrl-C)");
 }
@@ -196,7 +202,8 @@ bool should_stop(const CommonOptions& o, Clock::time_point start) {
 
 void run_list(const CommonOptions& o, bool verbose) {
   runtime::dds::Participant participant(o.domain);
-  const auto topics = discover(participant, std::chrono::milliseconds(static_cast<int>(o.wait_s * 1000)));
+  const auto topics =
+      discover(participant, std::chrono::milliseconds(static_cast<int>(o.wait_s * 1000)));
   for (const auto& [name, info] : topics) {
     std::printf("%-32s %-44s %zu pub, %zu sub\n", name.c_str(),
                 runtime::to_ros_type_name(info.type_name).c_str(), info.publishers.size(),
@@ -254,13 +261,19 @@ void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
     for (double d : dt) var += (d - mean) * (d - mean);
     const double stddev = std::sqrt(var / static_cast<double>(dt.size()));
     const auto [min_it, max_it] = std::minmax_element(dt.begin(), dt.end());
-    const double span_s = std::chrono::duration<double>(samples.back().first - samples.front().first).count();
+    const double span_s =
+        std::chrono::duration<double>(samples.back().first - samples.front().first).count();
     if (bandwidth) {
       const double bps = static_cast<double>(bytes) / span_s;
-      std::printf("%.3f MB/s from %zu messages, mean size %.0f B (min %zu B max %zu B)\n", bps / 1e6,
-                  samples.size(), static_cast<double>(bytes) / static_cast<double>(dt.size()),
-                  std::min_element(samples.begin(), samples.end(), [](auto& a, auto& b) { return a.second < b.second; })->second,
-                  std::max_element(samples.begin(), samples.end(), [](auto& a, auto& b) { return a.second < b.second; })->second);
+      std::printf("%.3f MB/s from %zu messages, mean size %.0f B (min %zu B max %zu B)\n",
+                  bps / 1e6, samples.size(),
+                  static_cast<double>(bytes) / static_cast<double>(dt.size()),
+                  std::min_element(samples.begin(), samples.end(),
+                                   [](auto& a, auto& b) { return a.second < b.second; })
+                      ->second,
+                  std::max_element(samples.begin(), samples.end(), [](auto& a, auto& b) {
+                    return a.second < b.second;
+                  })->second);
     } else {
       std::printf("average rate: %.3f Hz\n\tmin: %.6fs max: %.6fs std dev: %.6fs window: %zu\n",
                   1.0 / mean, *min_it, *max_it, stddev, samples.size());
@@ -268,12 +281,12 @@ void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
     std::fflush(stdout);
   };
   while (!should_stop(o, start)) {
-    reader.take(std::chrono::milliseconds(50), [&](std::span<const std::uint8_t> bytes,
-                                                   const dds_sample_info_t&) {
-      samples.emplace_back(Clock::now(), bytes.size());
-      ++total;
-      if (samples.size() > window) samples.pop_front();
-    });
+    reader.take(std::chrono::milliseconds(50),
+                [&](std::span<const std::uint8_t> bytes, const dds_sample_info_t&) {
+                  samples.emplace_back(Clock::now(), bytes.size());
+                  ++total;
+                  if (samples.size() > window) samples.pop_front();
+                });
     if (Clock::now() >= next_print) {
       report();
       next_print += std::chrono::seconds(1);
@@ -285,7 +298,8 @@ void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
 }  // namespace
 
 void add_topic_command(CLI::App& app) {
-  auto* topic = app.add_subcommand("topic", "Inspect topics of running graphs (any process, any host)");
+  auto* topic =
+      app.add_subcommand("topic", "Inspect topics of running graphs (any process, any host)");
   topic->require_subcommand(1);
   std::signal(SIGINT, on_interrupt);
   std::signal(SIGTERM, on_interrupt);
@@ -293,24 +307,28 @@ void add_topic_command(CLI::App& app) {
   static CommonOptions list_o;
   static bool verbose = false;
   list_o.wait_s = 1.5;
-  auto* list = topic->add_subcommand("list", "Topics seen through DDS discovery, with types and endpoint counts");
+  auto* list = topic->add_subcommand(
+      "list", "Topics seen through DDS discovery, with types and endpoint counts");
   add_common(list, list_o, false);
   list->add_flag("-v,--verbose", verbose, "show DDS type names and each endpoint's QoS");
   list->callback([] { run_list(list_o, verbose); });
 
   static CommonOptions echo_o;
   static introspection::YamlOptions yaml;
-  auto* echo = topic->add_subcommand("echo", "Print samples as YAML (images and clouds summarised)");
+  auto* echo =
+      topic->add_subcommand("echo", "Print samples as YAML (images and clouds summarised)");
   add_common(echo, echo_o, true);
   echo->add_option("-n,--count", echo_o.count, "print this many samples, then exit");
-  echo->add_option("--max-elements", yaml.max_list_elements, "longest list printed in full (0: all)");
+  echo->add_option("--max-elements", yaml.max_list_elements,
+                   "longest list printed in full (0: all)");
   echo->callback([] { run_echo(echo_o, yaml); });
 
   static CommonOptions hz_o;
   static std::size_t hz_window = 1000;
   auto* hz = topic->add_subcommand("hz", "Receive rate: mean, min/max/std of intervals");
   add_common(hz, hz_o, true);
-  hz->add_option("-w,--window", hz_window, "intervals in the sliding window")->capture_default_str();
+  hz->add_option("-w,--window", hz_window, "intervals in the sliding window")
+      ->capture_default_str();
   hz->callback([] { run_rate(hz_o, false, hz_window); });
 
   static CommonOptions bw_o;

@@ -100,6 +100,9 @@ runtime::ComponentSpec RunRecorderComponent::spec() {
            ParamSpec::string("symmetry", "none",
                              "symmetry for the orientation error: none, cube, cylinder_x|y|z"),
            ParamSpec::string("notes", "", "free text shown in the report"),
+           ParamSpec::string("truth_object", "",
+                             "object_name on /sim/ground_truth that is the target (the scene "
+                             "publishes one message per object); empty: `object`"),
            ParamSpec::string("model", "",
                              "mesh drawn over the scene in the cloud snapshots (built-in name or "
                              "file); empty: `object`"),
@@ -110,7 +113,8 @@ runtime::ComponentSpec RunRecorderComponent::spec() {
            ParamSpec::integer("width", 512, 1, 100000, "px", "image width"),
            ParamSpec::integer("height", 512, 1, 100000, "px", "image height"),
            ParamSpec::real("depth_snapshot_time_s", 1.0, 0.0, 1e9, "s",
-                           "the first depth image at or after this time is kept (Figure 9)"),
+                           "the first depth image at or after this time is kept (Figure 9); "
+                           "a shorter run keeps its last one"),
            ParamSpec::real_list("cloud_snapshot_times_s", {0.5, 1.0, 1.5}, "s",
                                 "scene/model snapshots (Figure 14) at these times")},
       .publishes = {},
@@ -162,8 +166,15 @@ RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Com
     }
   }
 
+  truth_object_ = ctx.param<std::string>("truth_object");
+  if (truth_object_.empty()) truth_object_ = info.object;
   ctx.subscribe<msgs::avs_msgs::GroundTruth>(
       "ground_truth", [this](runtime::SamplePtr<msgs::avs_msgs::GroundTruth> m) {
+        const std::string_view name = runtime::get_string(m->object_name);
+        if (name != truth_object_) {
+          if (other_objects_.size() < 16) other_objects_.insert(std::string(name));
+          return;
+        }
         Truth truth;
         truth.world = to_pose(m->pose_world);
         truth.p_camera_m = {m->pose_camera.position.x, m->pose_camera.position.y,
@@ -174,7 +185,8 @@ RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Com
         ++progress_.frames;
       });
   ctx.subscribe<msgs::sensor_msgs::Image>(
-      "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
+      "depth",
+      [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth_sample(std::move(m)); });
   ctx.subscribe<msgs::avs_msgs::TargetObservation>(
       "target", [this](runtime::SamplePtr<msgs::avs_msgs::TargetObservation> m) {
         assembler_->on_target(stamp_ns(m->header.stamp), m->valid, m->centroid_x_px,
@@ -215,6 +227,13 @@ RunRecorderComponent::~RunRecorderComponent() {
 }
 
 void RunRecorderComponent::on_deactivate() {
+  if (!depth_snapshot_taken_ && last_depth_) write_depth_snapshot(*last_depth_);
+  if (progress_.frames.load() == 0) {
+    std::string seen;
+    for (const auto& name : other_objects_) seen += (seen.empty() ? "" : ", ") + name;
+    log().error("no ground truth for object '", truth_object_,
+                "' (set truth_object); seen: ", seen.empty() ? "none" : seen);
+  }
   assembler_->flush();
   recorder_->flush();
   finished_ = true;
@@ -232,8 +251,21 @@ void RunRecorderComponent::on_depth(const msgs::sensor_msgs::Image& image) {
   assembler_->on_depth(stamp);
   ++progress_.depth_updates;
   progress_.last_stamp_ns = stamp;
-  const double t_s = static_cast<double>(stamp) * 1e-9;
-  if (depth_snapshot_taken_ || t_s < depth_snapshot_time_s_) return;
+}
+
+void RunRecorderComponent::on_depth_sample(runtime::SamplePtr<msgs::sensor_msgs::Image> image) {
+  on_depth(*image);
+  const double t_s = runtime::from_ros_time(image->header.stamp).seconds();
+  if (depth_snapshot_taken_) return;
+  if (t_s < depth_snapshot_time_s_) {
+    last_depth_ = std::move(image);  // shared, not copied
+    return;
+  }
+  write_depth_snapshot(*image);
+}
+
+void RunRecorderComponent::write_depth_snapshot(const msgs::sensor_msgs::Image& image) {
+  const double t_s = runtime::from_ros_time(image.header.stamp).seconds();
   if (runtime::get_string(image.encoding) != "32FC1" || image.step != image.width * 4 ||
       static_cast<std::uint64_t>(image.step) * image.height > image.data._length) {
     log().warn("depth snapshot skipped: expected packed 32FC1, got '",

@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <set>
+#include <string>
 #include <vector>
 
 #include "avs/msg/type_support.hpp"
@@ -38,6 +40,8 @@ class RunRecorderComponent final : public runtime::Component {
 
  private:
   void on_depth(const msgs::sensor_msgs::Image& image);
+  void on_depth_sample(runtime::SamplePtr<msgs::sensor_msgs::Image> image);
+  void write_depth_snapshot(const msgs::sensor_msgs::Image& image);
   void on_pose_camera(const msgs::geometry_msgs::PoseStamped& pose);
   void on_scene_points(const msgs::sensor_msgs::PointCloud2& cloud);
 
@@ -46,6 +50,9 @@ class RunRecorderComponent final : public runtime::Component {
   RecorderProgress progress_;
   double depth_snapshot_time_s_ = 0;
   bool depth_snapshot_taken_ = false;
+  runtime::SamplePtr<msgs::sensor_msgs::Image> last_depth_;
+  std::string truth_object_;
+  std::set<std::string> other_objects_;
   std::vector<double> cloud_times_s_;
   std::size_t next_cloud_ = 0;
   std::vector<Eigen::Vector3d> model_points_m_;

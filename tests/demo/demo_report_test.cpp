@@ -1,0 +1,107 @@
+// A short `avs demo` (issue 9, point 4): the run folder and its report exist, the figures are
+// valid PNGs with data drawn in them, and the results table's numbers are the ones computed
+// from the rows this run recorded (nothing hard-coded): summary.json is recomputed here from
+// frames.csv, and the run's rates follow from its own simulated duration.
+#include <png.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "avs/report/run_data.hpp"
+#include "avs/report/summary.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Distinct colours in a PNG (a blank or single-colour figure has 1 or 2).
+int distinct_colours(const fs::path& file, int& width, int& height) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_file(&png, file.c_str()) == 0) return -1;
+  png.format = PNG_FORMAT_RGB;
+  std::vector<unsigned char> rgb(PNG_IMAGE_SIZE(png));
+  if (png_image_finish_read(&png, nullptr, rgb.data(), 0, nullptr) == 0) return -1;
+  width = static_cast<int>(png.width);
+  height = static_cast<int>(png.height);
+  std::set<int> colours;
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) {
+    colours.insert(rgb[i] << 16 | rgb[i + 1] << 8 | rgb[i + 2]);
+    if (colours.size() > 64) break;
+  }
+  return static_cast<int>(colours.size());
+}
+
+/// The number after `"key": ` in summary.json (null -> NaN).
+double json_number(const std::string& json, const std::string& key) {
+  const std::regex re("\"" + key + "\":\\s*(null|[-0-9.eE+]+)");
+  std::smatch m;
+  if (!std::regex_search(json, m, re)) throw std::runtime_error("no key " + key);
+  return m[1] == "null" ? std::nan("") : std::stod(m[1]);
+}
+
+TEST(Demo, ShortRunMakesAReportFromItsOwnData) {
+  const fs::path dir = fs::temp_directory_path() / ("avs-demo-test-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const double seconds = 0.6;
+  const std::string log = (dir.string() + ".log");
+  const std::string command = std::string(AVS_PROGRAM) + " demo --seconds " +
+                              std::to_string(seconds) + " --out " + dir.string() + " > " + log +
+                              " 2>&1";
+  const int status = std::system(command.c_str());
+  const std::string output = read_file(log);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+
+  // The report folder: data, summary, page, figures.
+  for (const char* f : {"frames.csv", "meta.csv", "summary.json", "index.html"}) {
+    EXPECT_TRUE(fs::exists(dir / f)) << f << "\n" << output;
+  }
+  int pngs = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (entry.path().extension() != ".png") continue;
+    ++pngs;
+    int w = 0, h = 0;
+    const int colours = distinct_colours(entry.path(), w, h);
+    EXPECT_GT(colours, 2) << entry.path() << " is not a PNG with data drawn in it";
+    EXPECT_GT(w, 100);
+    EXPECT_GT(h, 100);
+  }
+  EXPECT_GE(pngs, 5) << output;
+  const std::string html = read_file(dir / "index.html");
+  EXPECT_NE(html.find(".png"), std::string::npos);
+
+  // The table's figures are the run's: recompute them from the recorded rows.
+  const avs::report::RunData run = avs::report::load_run(dir);
+  const avs::report::Summary s = avs::report::compute_summary(run);
+  const std::string json = read_file(dir / "summary.json");
+  EXPECT_EQ(json_number(json, "frames"), s.frames);
+  EXPECT_NEAR(json_number(json, "depth_rate_hz"), s.depth_rate_hz, 1e-6);
+  // 500 Hz depth in sim time, whatever the machine's speed: about seconds x 500 rows.
+  EXPECT_NEAR(s.frames, seconds * 500, 0.1 * seconds * 500);
+  EXPECT_NEAR(s.depth_rate_hz, 500.0, 5.0);
+  if (!std::isnan(s.position_error_mm_rms)) {
+    EXPECT_NEAR(json_number(json, "position_error_mm_rms"), s.position_error_mm_rms, 1e-6);
+  }
+  // The printed table carries the same figure.
+  std::ostringstream rate;
+  rate << std::lround(s.depth_rate_hz);
+  EXPECT_NE(output.find(rate.str()), std::string::npos) << output;
+  fs::remove_all(dir);
+  fs::remove(log);
+}
+
+}  // namespace

@@ -1,0 +1,180 @@
+// avs experiments [NAME...] [--json]: the paper's Sec. 7 as runnable scenarios on the simulated
+// closed loop. Each scenario runs the graph anew (nothing is reused or hard-coded), writes its
+// run folder with figures and index.html, and prints the paper's figures beside ours.
+#include <ctime>
+#include <fstream>
+#include <iostream>
+
+#include "avs/report/paper.hpp"
+#include "avs/report/report.hpp"
+#include "avs/report/table.hpp"
+#include "closed_loop.hpp"
+#include "commands.hpp"
+
+namespace avs::cli {
+
+namespace {
+
+struct Experiment {
+  std::string name;
+  std::string section;
+  std::string what;
+  ClosedLoopRun run;
+};
+
+ClosedLoopRun make_run(std::string scenario, std::string scene, std::string object,
+                       std::string symmetry, double duration_s) {
+  ClosedLoopRun run;
+  run.scenario = std::move(scenario);
+  run.scene = std::move(scene);
+  run.object = std::move(object);
+  run.symmetry = std::move(symmetry);
+  run.duration_s = duration_s;
+  return run;
+}
+
+std::vector<Experiment> experiments() {
+  std::vector<Experiment> list;
+  {
+    Experiment e{"tracking", "7.1.1", "ken swung laterally at 1 m/s, depth with active tracking",
+                 make_run("tracking", "swing", "ken", "none", 4.0)};
+    list.push_back(e);
+    e.name = "no_tracking";
+    e.section = "7.1.2";
+    e.what = "the same swing with the head held still";
+    e.run.scenario = "no_tracking";
+    e.run.tracking = false;
+    list.push_back(e);
+  }
+  list.push_back({"ken", "7.2.1", "ken on the manipulator trajectory, tracking and matching",
+                  make_run("ken", "manipulator_ken", "ken", "none", 3.0)});
+  list.push_back({"cube", "7.2.2", "10 cm cube on the manipulator trajectory",
+                  make_run("cube", "manipulator_cube", "cube", "cube", 3.0)});
+  list.push_back({"cylinder", "7.2.3", "cylinder on the manipulator trajectory",
+                  make_run("cylinder", "manipulator_cylinder", "cylinder", "cylinder_z", 3.0)});
+  {
+    Experiment e{"correction", "7.3", "ken on the manipulator trajectory, code correction on",
+                 make_run("correction", "manipulator_ken", "ken", "none", 3.0)};
+    list.push_back(e);
+    e.name = "correction_off";
+    e.what = "the same run with code correction off (Algorithm 1 disabled)";
+    e.run.scenario = "correction";
+    e.run.code_correction = false;
+    e.run.notes = "code correction OFF";
+    list.push_back(e);
+  }
+  list.push_back({"init", "7.4", "initial alignment of the static ken",
+                  make_run("init", "static_ken", "ken", "none", 0.5)});
+  return list;
+}
+
+/// `correction` runs with its `correction_off` twin; `tracking` alone does not pull in
+/// `no_tracking`.
+std::vector<Experiment> select(const std::vector<std::string>& names) {
+  const auto all = experiments();
+  if (names.empty()) return all;
+  std::vector<Experiment> chosen;
+  for (const auto& name : names) {
+    bool found = false;
+    for (const auto& e : all) {
+      if (e.name == name || (name == "correction" && e.name == "correction_off")) {
+        chosen.push_back(e);
+        found = true;
+      }
+    }
+    if (!found) {
+      std::string known;
+      for (const auto& e : all) {
+        if (e.name != "correction_off") known += (known.empty() ? "" : ", ") + e.name;
+      }
+      throw std::invalid_argument("unknown experiment '" + name + "' (known: " + known + ")");
+    }
+  }
+  return chosen;
+}
+
+std::filesystem::path default_out_dir() {
+  char stamp[32];
+  const std::time_t now = std::time(nullptr);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
+  return std::filesystem::path("avs-runs") / (std::string("experiments-") + stamp);
+}
+
+}  // namespace
+
+namespace {
+
+void add_experiments_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand(
+      "experiments",
+      "Run the paper's Sec. 7 experiments on the simulated closed loop: tracking, no_tracking, "
+      "ken, cube, cylinder, correction, init (all when none is named)");
+  static std::vector<std::string> names;
+  static bool json = false;
+  static std::string out;
+  static double time_scale = 1.0;
+  cmd->add_option("NAME", names, "experiments to run (default: all)");
+  cmd->add_flag("--json", json, "print one JSON object keyed by scenario name on stdout");
+  cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
+  cmd->add_option("--time-scale", time_scale,
+                  "multiply every scenario's simulated duration (short smoke runs: 0.2)")
+      ->check(CLI::Range(0.01, 10.0))
+      ->capture_default_str();
+  cmd->callback([] {
+    std::vector<Experiment> chosen;
+    try {
+      chosen = select(names);
+    } catch (const std::exception& e) {
+      std::cerr << "avs experiments: " << e.what() << "\n";
+      exit_status() = 2;
+      return;
+    }
+    const std::filesystem::path root = out.empty() ? default_out_dir() : std::filesystem::path(out);
+    std::vector<std::pair<std::string, report::Summary>> summaries;
+    std::string markdown;
+    int status = 0;
+    for (auto& e : chosen) {
+      if (interrupted_by_signal()) break;
+      e.run.dir = root / e.name;
+      e.run.duration_s *= time_scale;
+      std::cerr << "== " << e.name << " (Sec. " << e.section << "): " << e.what << "\n";
+      const ClosedLoopOutcome outcome = run_closed_loop(e.run, std::cerr);
+      if (outcome.status != 0) status = outcome.status;
+      try {
+        const report::Report r = report::make_report(e.run.dir);
+        for (const auto& failed : r.plots.failed) {
+          std::cerr << "FAILED figure " << failed.png << ": " << failed.reason << "\n";
+          status = 1;
+        }
+        const std::string table = report::format_comparison_table(e.run.scenario, r.summary);
+        (json ? std::cerr : std::cout)
+            << "\n"
+            << e.name << " (Sec. " << e.section << ", " << e.run.dir.string() << "/index.html)\n"
+            << table << "\n";
+        markdown += "## " + e.name + " (Sec. " + e.section + ")\n\n" + e.what + ". Report: `" +
+                    (e.run.dir / "index.html").string() + "`.\n\n" +
+                    report::format_comparison_markdown(e.run.scenario, r.summary) + "\n";
+        summaries.emplace_back(e.name, r.summary);
+      } catch (const std::exception& ex) {
+        std::cerr << "avs experiments: " << e.name << ": no report: " << ex.what() << "\n";
+        status = 1;
+      }
+    }
+    const std::string json_text = report::experiments_json(summaries);
+    std::ofstream(root / "experiments.json") << json_text << "\n";
+    std::ofstream(root / "experiments.md") << markdown;
+    if (json) std::cout << json_text << "\n";
+    std::cerr << "experiments: " << root.string() << " (experiments.json, experiments.md)\n";
+    if (interrupted_by_signal()) {
+      std::cerr << "avs experiments: interrupted: the results above are partial\n";
+      status = status == 0 ? 130 : status;
+    }
+    exit_status() = status;
+  });
+}
+
+}  // namespace
+
+AVS_REGISTER_COMMAND(add_experiments_command)
+
+}  // namespace avs::cli
