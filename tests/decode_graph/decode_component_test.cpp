@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -22,6 +23,7 @@
 #include "avs/graph/graph.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
+#include "avs/runtime/dds.hpp"
 #include "avs/sim/simulator.hpp"
 
 namespace avs::decode {
@@ -549,6 +551,41 @@ TEST(DecodeComponent, SimulatorPlaneAtOneMetre) {
       100.0 * static_cast<double>(last.lit_valid) / static_cast<double>(last.lit),
       static_cast<long long>(last.lit), static_cast<long long>(last.shadow_valid),
       static_cast<long long>(shadowed));
+}
+
+TEST(DecodeComponent, DropsAndTimingReachDiagnosticsOverDds) {
+  // /diagnostics goes out once per second of the (sim) clock, to readers in other participants:
+  // a plain DDS reader here sees the component's key/values (Component::diagnostic_values).
+  setenv("AVS_DOMAIN_ID", "146", 1);
+  const runtime::dds::Participant participant(146);
+  using Array = msgs::diagnostic_msgs::DiagnosticArray;
+  const runtime::dds::Topic topic(participant, msg::TypeSupport<Array>::descriptor(),
+                                  "rt/diagnostics", runtime::QosProfile{});
+  const runtime::dds::Reader reader(participant, topic, runtime::QosProfile{});
+  const GraphRun run = run_graph(146, 1.05, "{}", "{drop_frames: [100, 501]}");
+  ASSERT_NE(run.recorder, nullptr);
+  std::map<std::string, std::string> values;
+  for (;;) {
+    auto sample = runtime::make_sample<Array>();
+    void* buffers[1] = {sample.get()};
+    dds_sample_info_t info;
+    if (dds_take(reader.get(), buffers, &info, 1, 1) <= 0) break;
+    if (!info.valid_data) continue;
+    for (const auto& status : runtime::as_span(sample->status)) {
+      if (runtime::get_string(status.name) != "depth/decode") continue;
+      for (const auto& kv : runtime::as_span(status.values)) {
+        values[std::string(runtime::get_string(kv.key))] = runtime::get_string(kv.value);
+      }
+    }
+  }
+  ASSERT_FALSE(values.empty()) << "no /diagnostics status of depth/decode received";
+  EXPECT_EQ(values["dropped_frames"], "2");  // both drops happened before t = 1 s
+  // Frame 100 is the positive of bit 5: its negative is an incomplete pair; frame 501 is the
+  // negative of bit 7: its positive is simply replaced by the next one.
+  EXPECT_EQ(values["incomplete_pairs"], "1");
+  EXPECT_EQ(values["out_of_order_frames"], "0");
+  EXPECT_GT(std::stod(values["processing_ms_mean"]), 0.0);
+  EXPECT_TRUE(values.contains("callbacks")) << "the container's own values come first";
 }
 
 TEST(DecodeComponent, WrongFrameSizeFailsTheContainerLoudly) {
