@@ -19,12 +19,16 @@ PublisherWatch::PublisherWatch(int domain, const std::string& cyclone_xml,
       runtime::check_dds(d, "create DDS domain " + std::to_string(domain) + " for the watch");
     }
   }
-  participant_ = runtime::check_dds(
-      dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr),
-      "create the watch participant on domain " + std::to_string(domain));
+  participant_ = dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
+  if (participant_ < 0) {
+    if (domain_ > 0) dds_delete(domain_);
+    runtime::check_dds(participant_,
+                       "create the watch participant on domain " + std::to_string(domain));
+  }
   reader_ = dds_create_reader(participant_, DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
   if (reader_ < 0) {
     dds_delete(participant_);
+    if (domain_ > 0) dds_delete(domain_);
     runtime::check_dds(reader_, "create a DCPSPublication reader");
   }
   thread_ = std::thread([this] { run(); });
@@ -34,6 +38,9 @@ PublisherWatch::~PublisherWatch() {
   stop_ = true;
   if (thread_.joinable()) thread_.join();
   dds_delete(participant_);
+  // The domain's threads must end here: left to process exit, a security-plugin thread can
+  // run into OpenSSL after its atexit clean-up (seen as a segfault in libcrypto).
+  if (domain_ > 0) dds_delete(domain_);
 }
 
 void PublisherWatch::run() {

@@ -35,6 +35,7 @@ class PublisherWatch {
   void run();
   std::vector<std::string> topics_;
   Callback callback_;
+  int domain_ = 0;  ///< the domain created for `cyclone_xml`, deleted with the watch
   int participant_ = 0;
   int reader_ = 0;
   std::atomic<bool> stop_{false};
