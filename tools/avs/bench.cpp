@@ -42,14 +42,21 @@ void add_bench_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("bench", "Benchmarks against a peer measured in the same run");
   static std::string name;
   static bool json = false;
-  static std::vector<std::string> args;
   cmd->add_option("name", name, "benchmark name (omit to list them)");
   cmd->add_flag("--json", json, "print one JSON object (keys carry units)");
-  cmd->add_option("args", args, "arguments for the benchmark (e.g. --model FILE)");
-  cmd->allow_extras();
+  // Everything after the name goes to the benchmark in the order given (--model FILE, ...).
+  cmd->prefix_command();
+  cmd->footer("Arguments after NAME go to the benchmark in order, e.g. avs bench matching "
+              "--model my.ply --json");
   cmd->callback([cmd] {
-    auto extras = cmd->remaining();
-    args.insert(args.end(), extras.begin(), extras.end());
+    std::vector<std::string> args;
+    for (const auto& word : cmd->remaining()) {
+      if (word == "--json") {
+        json = true;
+      } else {
+        args.push_back(word);
+      }
+    }
     if (name.empty()) {
       for (const auto& b : bench::bench_registry()) {
         std::printf("%-12s %s\n", b.name.c_str(), b.description.c_str());
