@@ -244,8 +244,11 @@ TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
   for (std::size_t i = 0; i < depth.size(); ++i) {
     EXPECT_EQ(runtime::from_ros_time(rec.match[i]->header.stamp).ns, depth[i]);
   }
-  EXPECT_EQ(rec.match.front()->state, avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING)
-      << "the first image initialises and tracks";
+  EXPECT_EQ(rec.match.front()->state,
+            avs_msgs_msg_dds__MatchResult_Constants_STATE_INITIALISING)
+      << "the first image runs the initial alignment";
+  EXPECT_EQ(rec.match[1]->state, avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING)
+      << "and tracking goes on from it";
 
   // A pose per depth image, camera and world, stamped like the image.
   ASSERT_EQ(rec.camera.size(), depth.size());

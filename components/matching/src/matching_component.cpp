@@ -337,6 +337,11 @@ class MatchingComponent final : public runtime::Component {
   }
 
   static std::uint8_t state_of(const PipelineOutput& out) {
+    // The update on which the initial alignment ran reports INITIALISING (its processing time
+    // is the alignment's, Sec. 6.1), whether or not tracking starts from it.
+    if (out.track.initialised_this_frame && out.track.state != TrackingState::lost) {
+      return avs_msgs_msg_dds__MatchResult_Constants_STATE_INITIALISING;
+    }
     switch (out.track.state) {
       case TrackingState::tracking:
         return avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING;
