@@ -25,6 +25,8 @@ fi
 DELIVERY=${DELIVERY:-"B:/chatter C:/head/torque_command"}
 # host:topic whose loss the host's launcher must report when A dies.
 LOST=${LOST:-"B:/chatter C:/head/torque_command"}
+# 1: the torque command source is on A, so C's drive must command zero torque while A is down.
+TORQUE_CHECK=${TORQUE_CHECK:-1}
 
 skip() { echo "SKIPPED: $*"; exit 77; }
 fail() { echo "FAIL: $*"; dump_logs; exit 1; }
@@ -133,6 +135,7 @@ check_delivery() {  # check_delivery ROUND
 
 check_torque() {  # check_torque ROUND nonzero|zero: up to 5 drive_status samples agree
   local torques nonzero
+  ((TORQUE_CHECK)) || return 0
   for attempt in 1 2 3 4 5; do
     torques=$(torque_of_drive)
     [[ -n $torques ]] || fail "round $1: no /head/drive_status from the drive on C"
@@ -195,5 +198,5 @@ for h in B C; do
   kill -0 "${LAUNCHER[$h]}" 2>/dev/null || fail "host $h's avs launch ended"
   if grep -q "restarted container" "$WORK/$h.1.log"; then fail "a container on $h was restarted"; fi
 done
-echo "PASS: multi-host deployment ($MODE): delivery, loss reported, zero torque, recovery"
+echo "PASS: multi-host deployment ($MODE, $(basename "$DEPLOY")): delivery, loss reported,$( ((TORQUE_CHECK)) && echo " zero torque,") recovery"
 exit 0
