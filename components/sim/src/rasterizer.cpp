@@ -41,12 +41,15 @@ void raster_screen_triangle(const PinholeView& view, ScreenVertex p0, ScreenVert
   }
   if (!(area > 1e-9f)) return;  // degenerate or NaN
   const int row_end = view.last_row > 0 ? view.last_row : view.height;
+  const int col_end = view.last_col > 0 ? view.last_col : view.width;
   const int y_begin =
       std::max(view.first_row, static_cast<int>(std::ceil(std::min({p0.v, p1.v, p2.v}))));
   const int y_end =
       std::min(row_end - 1, static_cast<int>(std::floor(std::max({p0.v, p1.v, p2.v}))));
   const float u_min = std::min({p0.u, p1.u, p2.u}), u_max = std::max({p0.u, p1.u, p2.u});
-  if (y_begin > y_end || u_max < -0.5f || u_min > view.width - 0.5f) return;
+  if (y_begin > y_end || u_max < static_cast<float>(view.first_col) - 0.5f ||
+      u_min > static_cast<float>(col_end) - 0.5f)
+    return;
 
   const std::array<Edge, 3> edges = {Edge(p1, p2), Edge(p2, p0), Edge(p0, p1)};
   // w(x, y) = sum_i lambda_i w_i with lambda_i = E_i / area: a plane in (x, y).
@@ -54,8 +57,8 @@ void raster_screen_triangle(const PinholeView& view, ScreenVertex p0, ScreenVert
   const float dw_dx = (edges[0].a * p0.w + edges[1].a * p1.w + edges[2].a * p2.w) * inv_area;
   const float dw_dy = (edges[0].b * p0.w + edges[1].b * p1.w + edges[2].b * p2.w) * inv_area;
   const float w_00 = (edges[0].c * p0.w + edges[1].c * p1.w + edges[2].c * p2.w) * inv_area;
-  const float x_lo = std::max(0.0f, std::ceil(u_min));
-  const float x_hi = std::min(static_cast<float>(view.width - 1), std::floor(u_max));
+  const float x_lo = std::max(static_cast<float>(view.first_col), std::ceil(u_min));
+  const float x_hi = std::min(static_cast<float>(col_end - 1), std::floor(u_max));
 
   for (int y = y_begin; y <= y_end; ++y) {
     float left = x_lo, right = x_hi;
@@ -103,6 +106,18 @@ int clip_near(const std::array<Eigen::Vector3f, 3>& in, float near_m,
 }
 
 }  // namespace
+
+void PixelBox::add(const PixelBox& b) {
+  if (b.empty()) return;
+  if (empty()) {
+    *this = b;
+    return;
+  }
+  x0 = std::min(x0, b.x0);
+  y0 = std::min(y0, b.y0);
+  x1 = std::max(x1, b.x1);
+  y1 = std::max(y1, b.y1);
+}
 
 void DepthBuffer::reset(int w, int h) {
   width = w;

@@ -149,6 +149,8 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   truth_.projector_row.assign(pixels, std::numeric_limits<float>::quiet_NaN());
   truth_.object_index.assign(pixels, -1);
   truth_.code.assign(pixels, -1);
+  shadow_cell_u_.assign(pixels, -1);
+  shadow_cell_v_.assign(pixels, -1);
   truth_.valid = true;  // nothing in view yet
 }
 
@@ -162,49 +164,182 @@ const Renderer::Truth& Renderer::truth() const {
   return truth_;
 }
 
+namespace {
+
+/// Pixels an object's triangles can touch in `view`: the bounding box of its projected
+/// vertices with a pixel of margin (the whole view if a vertex is behind the near plane).
+PixelBox screen_box(const PinholeView& view, const std::vector<Eigen::Vector3f>& vertices) {
+  PixelBox whole{0, 0, view.width - 1, view.height - 1};
+  float u_min = std::numeric_limits<float>::infinity(), v_min = u_min;
+  float u_max = -u_min, v_max = -u_min;
+  for (const Eigen::Vector3f& p : vertices) {
+    if (!(p.z() >= view.near_m)) return whole;
+    const float w = 1.0f / p.z();
+    const float u = view.fx_px * p.x() * w + view.cx_px, v = view.fy_px * p.y() * w + view.cy_px;
+    u_min = std::min(u_min, u);
+    u_max = std::max(u_max, u);
+    v_min = std::min(v_min, v);
+    v_max = std::max(v_max, v);
+  }
+  if (!(u_max >= u_min) || u_max < -1.0f || v_max < -1.0f ||
+      u_min > static_cast<float>(view.width) || v_min > static_cast<float>(view.height)) {
+    return {};
+  }
+  return {std::max(0, static_cast<int>(std::floor(u_min)) - 1),
+          std::max(0, static_cast<int>(std::floor(v_min)) - 1),
+          std::min(view.width - 1, static_cast<int>(std::ceil(u_max)) + 1),
+          std::min(view.height - 1, static_cast<int>(std::ceil(v_max)) + 1)};
+}
+
+/// `view` restricted to the pixels of `clip`.
+PinholeView clipped(PinholeView view, const PixelBox& clip) {
+  const int row_end = view.last_row > 0 ? view.last_row : view.height;
+  view.first_row = std::max(view.first_row, clip.y0);
+  view.last_row = std::max(view.first_row, std::min(row_end, clip.y1 + 1));
+  view.first_col = clip.x0;
+  view.last_col = clip.x1 + 1;
+  return view;
+}
+
+void clear(DepthBuffer& buffer, const PixelBox& box) {
+  for (int y = box.y0; y <= box.y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * buffer.width;
+    std::fill(buffer.inv_depth.begin() + static_cast<std::ptrdiff_t>(row + box.x0),
+              buffer.inv_depth.begin() + static_cast<std::ptrdiff_t>(row + box.x1 + 1), 0.0f);
+    std::fill(buffer.triangle.begin() + static_cast<std::ptrdiff_t>(row + box.x0),
+              buffer.triangle.begin() + static_cast<std::ptrdiff_t>(row + box.x1 + 1), -1);
+  }
+}
+
+}  // namespace
+
 void Renderer::set_view(const std::vector<RenderObject>& objects) {
   if (objects.size() > static_cast<std::size_t>(std::numeric_limits<std::int16_t>::max())) {
     throw std::invalid_argument("sim::Renderer: too many objects");
   }
-  // 1. Both depth buffers and the per-triangle data.
+  // Which objects changed since the previous view? Any change of the object list: all.
+  const std::size_t n = objects.size();
+  bool full = !have_last_ || n != last_mesh_.size();
+  std::vector<bool> moved(n, true);
+  if (!full) {
+    for (std::size_t o = 0; o < n; ++o) {
+      if (objects[o].mesh != last_mesh_[o]) full = true;
+      moved[o] = objects[o].albedo != last_albedo_[o] ||
+                 objects[o].T_camera_object.matrix() != last_pose_[o];
+    }
+  }
+  if (!full && std::none_of(moved.begin(), moved.end(), [](bool m) { return m; })) return;
+  // 1. Vertices in both views, per-triangle data, screen boxes.
   prepare_triangles(objects);
-  // 2. Per camera pixel: surface point, shadow test, shading, code.
-  for (int y = 0; y < camera_view_.height; ++y) compute_row<false>(y, nullptr);
+  // 2. Regions to redo: where changed objects were or are now, in either view.
+  Box camera_dirty, shadow_dirty;
+  if (!full) {
+    for (std::size_t o = 0; o < n; ++o) {
+      if (!moved[o]) continue;
+      camera_dirty.add(camera_box_[o]);
+      camera_dirty.add(new_camera_box_[o]);
+      shadow_dirty.add(shadow_box_[o]);
+      shadow_dirty.add(new_shadow_box_[o]);
+    }
+    // Past about half the image the plain full pass is cheaper.
+    full = 2 * camera_dirty.area() > static_cast<long>(camera_view_.width) * camera_view_.height;
+  }
+  if (full) {
+    camera_buffer_.reset(camera_view_.width, camera_view_.height);
+    projector_buffer_.reset(shadow_view_.width, shadow_view_.height);
+    rasterize_all(objects, Box{0, 0, camera_view_.width - 1, camera_view_.height - 1},
+                  Box{0, 0, shadow_view_.width - 1, shadow_view_.height - 1});
+    // 3. Per camera pixel: surface point, shadow test, shading, code.
+    for (int y = 0; y < camera_view_.height; ++y) compute_row<false>(y, nullptr);
+  } else {
+    clear(camera_buffer_, camera_dirty);
+    clear(projector_buffer_, shadow_dirty);
+    rasterize_all(objects, camera_dirty, shadow_dirty);
+    // 3. Rows that see a changed region, or whose shadow test read a changed cell. Elsewhere
+    // the camera buffer, the triangles seen and the cells read are all as before.
+    for (int y = 0; y < camera_view_.height; ++y) {
+      const bool seen = !camera_dirty.empty() && y >= camera_dirty.y0 && y <= camera_dirty.y1;
+      if (seen || row_reads_shadow_cells(y, shadow_dirty)) compute_row<false>(y, nullptr);
+    }
+  }
   truth_.valid = false;
+  have_last_ = true;
+  last_mesh_.resize(n);
+  last_pose_.resize(n);
+  last_albedo_.resize(n);
+  for (std::size_t o = 0; o < n; ++o) {
+    last_mesh_[o] = objects[o].mesh;
+    last_pose_[o] = objects[o].T_camera_object.matrix();
+    last_albedo_[o] = objects[o].albedo;
+  }
+  camera_box_ = new_camera_box_;
+  shadow_box_ = new_shadow_box_;
+}
+
+bool Renderer::row_reads_shadow_cells(int y, const Box& cells) const {
+  if (cells.empty()) return false;
+  const std::size_t row = static_cast<std::size_t>(y) * camera_view_.width;
+  const std::int16_t* u = shadow_cell_u_.data() + row;
+  const std::int16_t* v = shadow_cell_v_.data() + row;
+  int hit = 0;  // branch-free, so it vectorises
+  for (int x = 0; x < camera_view_.width; ++x) {
+    hit |= static_cast<int>(u[x] >= cells.x0) & static_cast<int>(u[x] <= cells.x1) &
+           static_cast<int>(v[x] >= cells.y0) & static_cast<int>(v[x] <= cells.y1);
+  }
+  return hit != 0;
 }
 
 void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
-  camera_buffer_.reset(camera_view_.width, camera_view_.height);
-  projector_buffer_.reset(shadow_view_.width, shadow_view_.height);
   normal_camera_.clear();
   triangle_object_.clear();
   triangle_albedo_dn_.clear();
   triangle_normal_dot_projector_.clear();
+  camera_vertices_.resize(objects.size());
+  projector_vertices_.resize(objects.size());
+  new_camera_box_.resize(objects.size());
+  new_shadow_box_.resize(objects.size());
   for (std::size_t o = 0; o < objects.size(); ++o) {
     if (objects[o].mesh == nullptr)
       throw std::invalid_argument("sim::Renderer: object without mesh");
     const geometry::Mesh& mesh = *objects[o].mesh;
     const Eigen::Isometry3f T = objects[o].T_camera_object.cast<float>();
-    scratch_camera_.resize(mesh.vertices.size());
-    scratch_projector_.resize(mesh.vertices.size());
+    std::vector<Eigen::Vector3f>& camera = camera_vertices_[o];
+    std::vector<Eigen::Vector3f>& projector = projector_vertices_[o];
+    camera.resize(mesh.vertices.size());
+    projector.resize(mesh.vertices.size());
     for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-      scratch_camera_[v] = T * mesh.vertices[v];
-      scratch_projector_[v] = R_projector_camera_ * scratch_camera_[v] + t_projector_camera_m_;
+      camera[v] = T * mesh.vertices[v];
+      projector[v] = R_projector_camera_ * camera[v] + t_projector_camera_m_;
     }
-    const auto id_offset = static_cast<std::int32_t>(normal_camera_.size());
     for (const Eigen::Vector3i& t : mesh.triangles) {
-      const Eigen::Vector3f& a = scratch_camera_[t[0]];
-      normal_camera_.push_back(
-          (scratch_camera_[t[1]] - a).cross(scratch_camera_[t[2]] - a).normalized());
+      const Eigen::Vector3f& a = camera[t[0]];
+      normal_camera_.push_back((camera[t[1]] - a).cross(camera[t[2]] - a).normalized());
       triangle_object_.push_back(static_cast<std::int16_t>(o));
       triangle_albedo_dn_.push_back(kFullScaleDn * static_cast<float>(objects[o].albedo));
       triangle_normal_dot_projector_.push_back(
           normal_camera_.back().dot(projector_centre_camera_m_));
     }
-    rasterize(camera_view_, scratch_camera_, mesh.triangles, id_offset, config_.cull_back_faces,
-              camera_buffer_);
-    rasterize(shadow_view_, scratch_projector_, mesh.triangles, id_offset, config_.cull_back_faces,
-              projector_buffer_);
+    new_camera_box_[o] = screen_box(camera_view_, camera);
+    new_shadow_box_[o] = screen_box(shadow_view_, projector);
+  }
+}
+
+void Renderer::rasterize_all(const std::vector<RenderObject>& objects, const Box& camera_clip,
+                             const Box& shadow_clip) {
+  const PinholeView camera_view = clipped(camera_view_, camera_clip);
+  const PinholeView shadow_view = clipped(shadow_view_, shadow_clip);
+  std::int32_t id_offset = 0;
+  for (std::size_t o = 0; o < objects.size(); ++o) {
+    const geometry::Mesh& mesh = *objects[o].mesh;
+    if (!camera_clip.empty()) {
+      rasterize(camera_view, camera_vertices_[o], mesh.triangles, id_offset,
+                config_.cull_back_faces, camera_buffer_);
+    }
+    if (!shadow_clip.empty()) {
+      rasterize(shadow_view, projector_vertices_[o], mesh.triangles, id_offset,
+                config_.cull_back_faces, projector_buffer_);
+    }
+    id_offset += static_cast<std::int32_t>(mesh.triangles.size());
   }
 }
 
@@ -221,6 +356,8 @@ void Renderer::compute_row(int y, Truth* truth) {
   float* base_out = base_dn_.data() + row_start;
   float* gain_out = gain_dn_.data() + row_start;
   std::uint16_t* gray_out = gray_.data() + row_start;
+  std::int16_t* cell_u_out = shadow_cell_u_.data() + row_start;
+  std::int16_t* cell_v_out = shadow_cell_v_.data() + row_start;
   const Eigen::Vector3f* normals = normal_camera_.data();
   const float* albedo_dn = triangle_albedo_dn_.data();
   const float* normal_dot_projector = triangle_normal_dot_projector_.data();
@@ -257,6 +394,7 @@ void Renderer::compute_row(int y, Truth* truth) {
   for (int x = 0; x < width; ++x) {
     const std::int32_t id = ids[x];
     gray_out[x] = 0;
+    cell_u_out[x] = cell_v_out[x] = -1;
     if constexpr (kWithTruth) {
       truth->projector_row[row_start + x] = kNaN;
       truth->code[row_start + x] = -1;
@@ -277,8 +415,11 @@ void Renderer::compute_row(int y, Truth* truth) {
     bool lit = u > -0.5f && u < u_max && v > -0.5f && v < v_max;  // also false behind it
     const int code = lit ? row_code[static_cast<int>(v + 0.5f)] : -1;
     if (code >= 0) {
-      const std::size_t j = static_cast<std::size_t>((v + 0.5f) * scale) * shadow_width +
-                            static_cast<std::size_t>((u + 0.5f) * scale);
+      const auto cell_u = static_cast<std::size_t>((u + 0.5f) * scale);
+      const auto cell_v = static_cast<std::size_t>((v + 0.5f) * scale);
+      const std::size_t j = cell_v * shadow_width + cell_u;
+      cell_u_out[x] = static_cast<std::int16_t>(cell_u);
+      cell_v_out[x] = static_cast<std::int16_t>(cell_v);
       const float w_seen = shadow_depth[j];
       // Something nearer to the projector covers this point: projector shadow.
       lit = shadow_id[j] == id || !(w_seen > 0) || qz_row[x] * w_seen <= 1.0f + bias * w_seen;

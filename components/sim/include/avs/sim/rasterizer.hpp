@@ -18,6 +18,17 @@ struct PinholeView {
   float near_m = 0.05f;  ///< triangles are clipped against z = near_m
   int first_row = 0;     ///< rows outside [first_row, last_row) are not rasterised
   int last_row = 0;      ///< 0 = height
+  int first_col = 0;     ///< columns outside [first_col, last_col) are not rasterised
+  int last_col = 0;      ///< 0 = width
+};
+
+/// Inclusive rectangle of pixels; empty when x1 < x0 or y1 < y0.
+struct PixelBox {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  bool empty() const { return x1 < x0 || y1 < y0; }
+  long area() const { return empty() ? 0 : static_cast<long>(x1 - x0 + 1) * (y1 - y0 + 1); }
+  /// Grows to the bounding box of both.
+  void add(const PixelBox& b);
 };
 
 /// Per pixel: 1/z of the nearest surface (0 = nothing) and its triangle id (-1 = nothing).
