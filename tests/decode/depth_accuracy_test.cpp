@@ -125,6 +125,31 @@ TEST(DepthAccuracy, PlaneAtOneMetreWithLensDistortion) {
   decode_and_report(config, scene, "table, distorted lenses", 1.5);
 }
 
+// Sub-code refinement (docs/decode.md): the line fit along the camera column removes most of the
+// code-centre quantisation; the plain path above is unchanged (subcode_half_window = 0).
+TEST(DepthAccuracy, PlaneAtOneMetreSubcodeRefinement) {
+  DecoderConfig config;
+  config.subcode_half_window = 4;
+  const auto scene = render_plane(config.geometry, plane_at_one_metre());
+  const Accuracy a = decode_and_report(config, scene, "table, sub-code h = 4", 0.4);
+  DecoderConfig plain;
+  const Accuracy b = decode_and_report(plain, scene, "table, code centres", 1.25);
+  EXPECT_LT(a.rms_m, 0.4 * b.rms_m);
+  EXPECT_EQ(a.valid, b.valid) << "refinement changes depth values, never validity";
+}
+
+TEST(DepthAccuracy, PlaneAtOneMetreSubcodeRefinementWithLensDistortion) {
+  DecoderConfig config;
+  config.geometry.camera.k1 = -0.12;
+  config.geometry.camera.k2 = 0.05;
+  config.geometry.camera.p1 = 0.001;
+  config.geometry.projector.k1 = 0.08;
+  config.geometry.projector.k2 = -0.02;
+  config.subcode_half_window = 4;
+  const auto scene = render_plane(config.geometry, plane_at_one_metre());
+  decode_and_report(config, scene, "table, distorted lenses, sub-code h = 4", 0.85);
+}
+
 TEST(DepthAccuracy, PointMapFollowsDepthAndRays) {
   DecoderConfig config;
   config.compute_point_map = true;

@@ -73,7 +73,16 @@ Run run(const Setup& setup) {
 
   decode::DecoderConfig decoder_config;
   decoder_config.geometry = sim_config.renderer.geometry;
+  if (const char* h = std::getenv("AVS_MATCHING_SUBCODE")) {
+    decoder_config.subcode_half_window = std::atoi(h);
+  }
   decode::RollingDecoder decoder(decoder_config);
+  // AVS_MATCHING_DEPTH=truth: the renderer's ground-truth depth of the newest frame instead of
+  // the decoded map (the matching floor without decoding errors).
+  const bool truth_depth = [] {
+    const char* d = std::getenv("AVS_MATCHING_DEPTH");
+    return d != nullptr && std::string(d) == "truth";
+  }();
 
   ModelCloudConfig model_config;
   model_config.target_points = object.model_points;
@@ -137,8 +146,10 @@ Run run(const Setup& setup) {
     const decode::DecodeResult depth = decoder.push_frame(input);
     if (!depth.depth_updated || f + 1 < window) continue;
     ++out.depth_updates;
-    const PipelineOutput result = pipeline.process(
-        {depth.depth_m.data(), depth.width, depth.height, depth.width}, frame.truth.time_s);
+    const float* depth_data =
+        truth_depth ? simulator.renderer().depth_m().data() : depth.depth_m.data();
+    const PipelineOutput result =
+        pipeline.process({depth_data, depth.width, depth.height, depth.width}, frame.truth.time_s);
     if (result.track.initialised_this_frame) out.initial_ms = result.processing_ms;
     if (std::getenv("AVS_MATCHING_DEBUG") != nullptr) {
       const PoseError e =

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "rolling_kernel.hpp"
+#include "subcode.hpp"
 
 namespace avs::decode {
 namespace {
@@ -38,6 +39,42 @@ bool in_range(float z, const DecoderConfig& c) {
   return z > c.min_depth_m && z < c.max_depth_m;
 }
 
+std::unique_ptr<detail::SubcodeRefiner> make_refiner(const DecoderConfig& c) {
+  if (c.subcode_half_window <= 0) return nullptr;
+  if (c.triangulation != TriangulationMethod::kRayPlaneTable) {
+    throw std::invalid_argument(
+        "rolling decoder: sub-code refinement (subcode_half_window " +
+        std::to_string(c.subcode_half_window) +
+        ") is implemented for table triangulation only, not for the reference solve");
+  }
+  if (c.subcode_steps < 1 || c.subcode_steps > 256) {
+    throw std::invalid_argument("rolling decoder: subcode_steps " +
+                                std::to_string(c.subcode_steps) + " outside 1..256");
+  }
+  return std::make_unique<detail::SubcodeRefiner>(
+      detail::SubcodeParams{c.geometry.camera.width, c.geometry.camera.height,
+                            c.subcode_half_window, c.subcode_max_jump});
+}
+
+/// Depth from fractional codes through the sub-code planes (NaN codes give NaN).
+void triangulate_subcode(const DepthTable& table, const float* refined, const DecoderConfig& c,
+                         float* depth_out) {
+  const float* planes = table.subcode_planes();
+  const auto steps = static_cast<float>(table.subcode_steps());
+  const int count = table.subcode_plane_count();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float* rx = table.ray_x();
+  const float* ry = table.ray_y();
+  const int pixels = table.pixel_count();
+  for (int i = 0; i < pixels; ++i) {
+    const float position = (refined[i] + 0.5f) * steps + 0.5f;
+    const bool ok = position >= 0.0f && position < static_cast<float>(count);
+    const float* pl = planes + 4 * (ok ? static_cast<int>(position) : 0);
+    const float z = 1.0f / (pl[0] * rx[i] + pl[1] * ry[i] + pl[2]);
+    depth_out[i] = (ok && z > c.min_depth_m && z < c.max_depth_m) ? z : nan;
+  }
+}
+
 }  // namespace
 
 std::uint32_t update_gray_with_correction(std::uint32_t gray, int k, int new_bit, int bit_count) {
@@ -54,7 +91,7 @@ std::uint32_t update_gray_with_correction(std::uint32_t gray, int k, int new_bit
 
 RollingDecoder::RollingDecoder(DecoderConfig config)
     : config_(std::move(config)),
-      table_(config_.geometry),
+      table_(config_.geometry, config_.subcode_half_window > 0 ? config_.subcode_steps : 0),
       reference_(config_.geometry),
       width_(config_.geometry.camera.width),
       height_(config_.geometry.camera.height),
@@ -77,7 +114,16 @@ RollingDecoder::RollingDecoder(DecoderConfig config)
   if (config_.compute_point_map) points_.assign(pixels, Eigen::Vector3f::Constant(kNan));
   pair_of_bit_.assign(static_cast<std::size_t>(bit_count_),
                       std::numeric_limits<std::int64_t>::min() / 2);
+  refiner_ = make_refiner(config_);
+  if (refiner_) {
+    codes_.assign(pixels, -1);
+    refined_codes_.assign(pixels, kNan);
+  }
 }
+
+RollingDecoder::~RollingDecoder() = default;
+RollingDecoder::RollingDecoder(RollingDecoder&&) noexcept = default;
+RollingDecoder& RollingDecoder::operator=(RollingDecoder&&) noexcept = default;
 
 void RollingDecoder::reset() {
   std::fill(gray_.begin(), gray_.end(), 0);
@@ -193,7 +239,7 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
   args.code_correction = config_.code_correction;
   args.full_mask = full;
   const bool table_path = config_.triangulation == TriangulationMethod::kRayPlaneTable;
-  if (all_fresh && table_path) {
+  if (all_fresh && table_path && !refiner_) {
     args.depth_m = depth_out;
     args.ray_x = table_.ray_x();
     args.ray_y = table_.ray_y();
@@ -209,6 +255,8 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
   const std::size_t pixels = depth_m_.size();
   if (!all_fresh) {
     std::fill_n(depth_out, pixels, kNan);  // a bit of the window is missing
+  } else if (refiner_) {
+    refine_depth(depth_out);
   } else if (!table_path) {
     const int code_count = config_.geometry.layout.code_count;
     for (std::size_t i = 0; i < pixels; ++i) {
@@ -222,6 +270,17 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
   DecodeResult result = make_result(true);
   result.depth_m = std::span<const float>(depth_out, pixels);
   return result;
+}
+
+void RollingDecoder::refine_depth(float* depth_out) {
+  const auto full = static_cast<std::uint16_t>((1u << bit_count_) - 1u);
+  const int code_count = config_.geometry.layout.code_count;
+  for (std::size_t i = 0; i < codes_.size(); ++i) {
+    const int code = static_cast<int>(gray_to_binary(gray_[i]));
+    codes_[i] = static_cast<std::int16_t>(valid_[i] == full && code < code_count ? code : -1);
+  }
+  refiner_->refine(codes_.data(), refined_codes_.data());
+  triangulate_subcode(table_, refined_codes_.data(), config_, depth_out);
 }
 
 void RollingDecoder::fill_point_map() {
@@ -278,12 +337,14 @@ FullCycleResult decode_full_cycle(const DecoderConfig& config,
                                   " frame for bit " + std::to_string(k));
     }
   }
-  const DepthTable table(g);
+  const DepthTable table(g, config.subcode_half_window > 0 ? config.subcode_steps : 0);
   const ReferenceTriangulator reference(g);
+  const std::unique_ptr<detail::SubcodeRefiner> refiner = make_refiner(config);
   const bool table_path = config.triangulation == TriangulationMethod::kRayPlaneTable;
   FullCycleResult result;
   result.depth_m.assign(static_cast<std::size_t>(width) * height, kNan);
   result.code.assign(result.depth_m.size(), -1);
+  std::vector<std::int16_t> refine_codes(refiner ? result.depth_m.size() : 0, -1);
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       std::uint32_t gray = 0;
@@ -298,11 +359,17 @@ FullCycleResult decode_full_cycle(const DecoderConfig& config,
       const int code = static_cast<int>(gray_to_binary(gray));
       if (!known || code >= g.layout.code_count) continue;
       const int i = y * width + x;
+      if (refiner) refine_codes[static_cast<std::size_t>(i)] = static_cast<std::int16_t>(code);
       const float z = table_path ? table.depth(i, code) : reference.depth(i, code);
       if (!in_range(z, config)) continue;
       result.depth_m[i] = z;
       result.code[i] = code;
     }
+  }
+  if (refiner) {
+    std::vector<float> refined(refine_codes.size(), kNan);
+    refiner->refine(refine_codes.data(), refined.data());
+    triangulate_subcode(table, refined.data(), config, result.depth_m.data());
   }
   return result;
 }

@@ -29,7 +29,7 @@ void check_geometry(const SensorGeometry& g) {
 
 }  // namespace
 
-DepthTable::DepthTable(const SensorGeometry& g) {
+DepthTable::DepthTable(const SensorGeometry& g, int subcode_steps) {
   check_geometry(g);
   width_ = g.camera.width;
   height_ = g.camera.height;
@@ -71,36 +71,57 @@ DepthTable::DepthTable(const SensorGeometry& g) {
   // the rays' scatter matrix, the plane passing through the centre by construction).
   const float nan = std::numeric_limits<float>::quiet_NaN();
   planes_.assign(4 * static_cast<std::size_t>(invalid_index_ + 1), nan);
-  const Eigen::Vector3d centre = g.projector_centre_camera_m();
-  const Eigen::Matrix3d R_camera_projector = g.R_projector_camera.transpose();
   const int column_step = g.projector.has_distortion() ? 1 : std::max(1, g.projector.width - 1);
   for (int code = 0; code < g.layout.code_count; ++code) {
-    const double row = g.code_centre_row(code);
-    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    std::vector<Eigen::Vector3d> rays;
-    for (int u = 0; u < g.projector.width; u += column_step) {
-      const Eigen::Vector3d d = (R_camera_projector * g.projector.ray(u, row)).normalized();
-      scatter += d * d.transpose();
-      rays.push_back(d);
-    }
-    if (rays.size() < 2) {
-      rays.push_back(
-          (R_camera_projector * g.projector.ray(g.projector.width - 1, row)).normalized());
-      scatter += rays.back() * rays.back().transpose();
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
-    const Eigen::Vector3d normal = solver.eigenvectors().col(0);
-    for (const auto& d : rays)
-      max_plane_fit_error_ = std::max(max_plane_fit_error_, std::abs(normal.dot(d)));
-    // Plane n . X = n . centre; a camera ray X = z (x, y, 1) meets it at z = 1 / (n' . (x, y, 1))
-    // with n' = n / (n . centre).
-    const double offset = normal.dot(centre);
-    if (std::abs(offset) < 1e-12) continue;  // plane through the camera centre: no depth
-    const Eigen::Vector3d abc = normal / offset;
-    for (int i = 0; i < 3; ++i)
-      planes_[4 * static_cast<std::size_t>(code) + i] = static_cast<float>(abc[i]);
-    planes_[4 * static_cast<std::size_t>(code) + 3] = 0.0f;
+    fit_row_plane(g, g.code_centre_row(code), column_step,
+                  planes_.data() + 4 * static_cast<std::size_t>(code), &max_plane_fit_error_);
   }
+  if (subcode_steps > 0) {
+    // Sub-code planes: projector rows from the lower edge of code 0 to the upper edge of the
+    // last code in steps of 1 / subcode_steps code. With projector distortion the fit uses
+    // every 8th column (the planes are a fit either way; see max_plane_fit_error()).
+    subcode_steps_ = subcode_steps;
+    const int count = g.layout.code_count * subcode_steps + 1;
+    subcode_planes_.assign(4 * static_cast<std::size_t>(count), nan);
+    const int sub_step = g.projector.has_distortion() ? 8 : column_step;
+    double ignored = 0;
+    for (int j = 0; j < count; ++j) {
+      const double code = static_cast<double>(j) / subcode_steps - 0.5;
+      fit_row_plane(g, subcode_row(g, code), sub_step,
+                    subcode_planes_.data() + 4 * static_cast<std::size_t>(j), &ignored);
+    }
+  }
+}
+
+double DepthTable::subcode_row(const SensorGeometry& g, double code) {
+  return g.layout.first_row + g.layout.rows_per_code * code + 0.5 * (g.layout.rows_per_code - 1);
+}
+
+void DepthTable::fit_row_plane(const SensorGeometry& g, double row, int column_step, float* abc0,
+                               double* max_fit_error) {
+  const Eigen::Vector3d centre = g.projector_centre_camera_m();
+  const Eigen::Matrix3d R_camera_projector = g.R_projector_camera.transpose();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  std::vector<Eigen::Vector3d> rays;
+  for (int u = 0; u < g.projector.width; u += column_step) {
+    const Eigen::Vector3d d = (R_camera_projector * g.projector.ray(u, row)).normalized();
+    scatter += d * d.transpose();
+    rays.push_back(d);
+  }
+  if (rays.size() < 2 || (g.projector.width - 1) % column_step != 0) {
+    rays.push_back((R_camera_projector * g.projector.ray(g.projector.width - 1, row)).normalized());
+    scatter += rays.back() * rays.back().transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  const Eigen::Vector3d normal = solver.eigenvectors().col(0);
+  for (const auto& d : rays) *max_fit_error = std::max(*max_fit_error, std::abs(normal.dot(d)));
+  // Plane n . X = n . centre; a camera ray X = z (x, y, 1) meets it at z = 1 / (n' . (x, y, 1))
+  // with n' = n / (n . centre).
+  const double offset = normal.dot(centre);
+  if (std::abs(offset) < 1e-12) return;  // plane through the camera centre: no depth (NaN)
+  const Eigen::Vector3d abc = normal / offset;
+  for (int i = 0; i < 3; ++i) abc0[i] = static_cast<float>(abc[i]);
+  abc0[3] = 0.0f;
 }
 
 ReferenceTriangulator::ReferenceTriangulator(const SensorGeometry& g)

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -15,6 +16,10 @@
 #include "avs/decode/triangulation.hpp"
 
 namespace avs::decode {
+
+namespace detail {
+class SubcodeRefiner;
+}
 
 /// A non-owning 8-bit monochrome image.
 struct ImageView8 {
@@ -49,6 +54,16 @@ struct DecoderConfig {
   float max_depth_m = 20.0f;
   TriangulationMethod triangulation = TriangulationMethod::kRayPlaneTable;
   bool compute_point_map = false;  ///< also fill DecodeResult::points_camera_m
+  /// Sub-code refinement (docs/decode.md): 0 = off, triangulate code centres (section 4.3's
+  /// quantisation); h > 0 = fit a line to the codes of the 2h + 1 rows around each pixel in its
+  /// camera column (the coded direction) and triangulate the fitted fractional code through
+  /// sub-code planes (DepthTable::subcode_planes). Table triangulation only.
+  int subcode_half_window = 0;
+  /// Valid codes of a column differing by more than this per row mark a discontinuity: a
+  /// window containing one keeps the plain code.
+  int subcode_max_jump = 2;
+  /// Sub-code planes per code (the fitted code is rounded to 1 / steps of a code).
+  int subcode_steps = 16;
 };
 
 struct DecoderStats {
@@ -82,6 +97,9 @@ std::uint32_t update_gray_with_correction(std::uint32_t gray, int k, int new_bit
 class RollingDecoder {
  public:
   explicit RollingDecoder(DecoderConfig config);
+  ~RollingDecoder();
+  RollingDecoder(RollingDecoder&&) noexcept;
+  RollingDecoder& operator=(RollingDecoder&&) noexcept;
 
   /// Feed one frame (the image is copied when it is a positive). Returns depth_updated = true
   /// when the frame completed a positive/negative pair.
@@ -114,6 +132,7 @@ class RollingDecoder {
   void update_reference(const ImageView8& positive, const ImageView8& negative, int bit_index,
                         bool all_fresh);
   void fill_point_map();
+  void refine_depth(float* depth_out);
 
   DecoderConfig config_;
   DepthTable table_;
@@ -132,13 +151,16 @@ class RollingDecoder {
   std::int64_t newest_pair_cycle_ = -1;
   int newest_pair_bit_ = -1;
   DecoderStats stats_;
+  std::unique_ptr<detail::SubcodeRefiner> refiner_;  ///< set when subcode_half_window > 0
+  std::vector<std::int16_t> codes_;                  ///< refinement scratch
+  std::vector<float> refined_codes_;
 };
 
 /// Full-cycle decode (section 4.1): all 2n frames of one cycle, matched by bit index and
 /// polarity, decoded at once without correction. Same triangulation as the rolling decoder.
 struct FullCycleResult {
   std::vector<float> depth_m;  ///< NaN where invalid
-  std::vector<int> code;       ///< binary code, -1 where invalid
+  std::vector<int> code;       ///< binary code, -1 where invalid (before sub-code refinement)
 };
 FullCycleResult decode_full_cycle(const DecoderConfig& config,
                                   std::span<const PatternFrame> frames);

@@ -2,6 +2,7 @@
 // plain per-pixel 3x3 solve of Eq. 4 as a reference.
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,7 +17,8 @@ namespace avs::decode {
 /// rays of that row's pixels). Depth along the camera z axis is then z = 1 / (a x + b y + c).
 class DepthTable {
  public:
-  explicit DepthTable(const SensorGeometry& geometry);
+  /// subcode_steps > 0 also builds the sub-code planes (subcode_planes()).
+  explicit DepthTable(const SensorGeometry& geometry, int subcode_steps = 0);
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -44,6 +46,26 @@ class DepthTable {
     return 1.0f / (pl[0] * ray_x_[pixel_index] + pl[1] * ray_y_[pixel_index] + pl[2]);
   }
 
+  /// Sub-code planes for a fractional code u (projector row first_row + rows_per_code * u +
+  /// (rows_per_code - 1) / 2, i.e. u = c is code c's centre row as planes() uses): entry j is
+  /// the plane at u = j / subcode_steps() - 1/2, j = 0 .. code_count * subcode_steps(), 4 floats
+  /// (a, b, c, 0) each. Empty unless built with subcode_steps > 0.
+  const float* subcode_planes() const {
+    return subcode_planes_.empty() ? nullptr : subcode_planes_.data();
+  }
+  int subcode_steps() const { return subcode_steps_; }
+  int subcode_plane_count() const { return static_cast<int>(subcode_planes_.size() / 4); }
+  /// Depth of `pixel_index` for fractional code u (nearest sub-code plane); NaN outside the
+  /// coded range or without sub-code planes.
+  float subcode_depth(int pixel_index, float u) const {
+    const float position = (u + 0.5f) * static_cast<float>(subcode_steps_) + 0.5f;
+    if (!(position >= 0.0f) || position >= static_cast<float>(subcode_plane_count())) {
+      return std::numeric_limits<float>::quiet_NaN();
+    }
+    const float* pl = subcode_planes_.data() + 4 * static_cast<int>(position);
+    return 1.0f / (pl[0] * ray_x_[pixel_index] + pl[1] * ray_y_[pixel_index] + pl[2]);
+  }
+
   /// Largest distance (m) between a fitted plane and the rays of its row, over all codes: 0
   /// without projector distortion; reported so that callers can see the plane approximation.
   double max_plane_fit_error() const { return max_plane_fit_error_; }
@@ -58,6 +80,15 @@ class DepthTable {
   std::vector<float> column_ray_x_;
   std::vector<float> row_ray_y_;
   double max_plane_fit_error_ = 0;
+  int subcode_steps_ = 0;
+  std::vector<float> subcode_planes_;
+
+  static double subcode_row(const SensorGeometry& g, double code);
+  /// Plane through the projector centre and projector row `row` (fitted to every column_step-th
+  /// column's ray) as (a, b, c, 0) with 1 / z = a x + b y + c; leaves NaN when it passes through
+  /// the camera centre. Raises *max_fit_error to the worst ray's sine to the plane.
+  static void fit_row_plane(const SensorGeometry& g, double row, int column_step, float* abc0,
+                            double* max_fit_error);
 };
 
 /// Eq. 4 solved per pixel: F r_c = R with the undistorted camera pixel (x_c, y_c) and the

@@ -1,0 +1,44 @@
+// Sub-code refinement: a fractional projector code per pixel from the decoded code staircase
+// along the coded image direction (camera columns), so that triangulation is no longer limited
+// to code centres (section 4.3's quantisation). See docs/decode.md, "Sub-code refinement".
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace avs::decode::detail {
+
+struct SubcodeParams {
+  int width = 0;
+  int height = 0;
+  /// Rows above and below the pixel used by the fit (window 2h + 1 rows of one column).
+  int half_window = 4;
+  /// Neighbouring valid codes of a column that differ by more than this (per row between them)
+  /// mark a surface discontinuity; a window containing one keeps the plain code.
+  int max_jump = 2;
+};
+
+/// Per column, a least-squares line code(y) through the valid codes of the window
+/// [y - h, y + h]; its value at y (clamped to the pixel's code +- 1) is the refined code.
+/// Pixels whose window has a discontinuity or fewer than 3 valid codes keep their code.
+class SubcodeRefiner {
+ public:
+  explicit SubcodeRefiner(SubcodeParams params);
+
+  /// codes: width * height, -1 where invalid. refined: width * height, NaN where invalid.
+  void refine(const std::int16_t* codes, float* refined);
+
+  const SubcodeParams& params() const { return params_; }
+
+ private:
+  void add_row(const std::int16_t* codes, int y, int sign);
+
+  SubcodeParams params_;
+  // Per column running sums over the window's valid codes (exact integers).
+  std::vector<std::int32_t> n_, sy_, syy_, sc_, scy_, jumps_;
+  std::vector<std::uint8_t> jump_;        ///< per pixel: a discontinuity to the previous valid code
+  std::vector<std::int16_t> previous_;    ///< per column: last valid code seen
+  std::vector<std::int32_t> previous_y_;  ///< per column: its row
+};
+
+}  // namespace avs::decode::detail
