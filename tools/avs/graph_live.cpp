@@ -152,9 +152,8 @@ struct Options {
 };
 
 int run_graph_view(const Options& o) {
-  const int domain = runtime::dds::effective_domain(o.domain < 0 ? 0 : o.domain);
-  runtime::dds::Participant participant(
-      static_cast<dds_domainid_t>(o.domain < 0 ? domain : o.domain));
+  const int domain = o.domain >= 0 ? o.domain : runtime::dds::effective_domain(0);
+  runtime::dds::Participant participant(static_cast<dds_domainid_t>(domain));
   const std::string self = [&] {
     dds_guid_t g;
     dds_get_guid(participant.get(), &g);
@@ -298,8 +297,8 @@ int run_graph_view(const Options& o) {
                                         : "participant " + guid.substr(0, 8) + "…";
   };
 
-  std::cout << "avs graph: domain " << (o.domain < 0 ? domain : o.domain) << ", " << std::fixed
-            << std::setprecision(1) << o.duration_s << " s of discovery\n";
+  std::cout << "avs graph: domain " << domain << ", " << std::fixed << std::setprecision(1)
+            << o.duration_s << " s of discovery\n";
   std::cout << "components (from /diagnostics):\n";
   if (health.empty())
     std::cout << "  (none reported; containers publish /diagnostics every second)\n";

@@ -358,7 +358,9 @@ int launch_graph(const std::string& file, const std::vector<std::string>& words,
 }
 
 void add_launch_command(CLI::App& app) {
-  auto* cmd = app.add_subcommand("launch", "Start a YAML graph: one child process per container");
+  auto* cmd = app.add_subcommand(
+      "launch",
+      "Start a YAML graph, or one host of a deployment (--host): a child process per container");
   static std::string file;
   static std::string host;
   static std::vector<std::string> words;
