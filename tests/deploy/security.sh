@@ -5,7 +5,8 @@
 #   3. a participant without security, and one whose identity comes from another CA, read
 #      nothing;
 #   4. an authenticated identity without a publish grant cannot write torque commands (its
-#      writer is refused), and a writer without security does not reach a secure reader;
+#      writer is refused), and neither a writer without security nor one whose identity comes
+#      from another CA reaches a secure reader;
 #   5. on the wire: a known plaintext marker in every command is in the UDP payloads of a
 #      plain run and in none of a secure one.
 # Usage: security.sh AVS SOURCE_DIR.  Exit 77 when Cyclone's security plugins are missing.
@@ -99,6 +100,15 @@ sleep 1
 out=$(echo_with "$W/secure.yaml" observer 8) && fail "a plain writer reached the secure reader: $out"
 grep -q avsRogue9 <<<"$out" && fail "a plain writer's command reached the secure reader"
 echo "ok: a writer without security does not reach the secure reader"
+kill -TERM "${PIDS[-1]}" 2>/dev/null
+
+bash -c "eval \"\$('$AVS' deploy env '$W/intruder.yaml' --host local --participant commands)\" &&
+  exec '$AVS' container '$SRC/tests/deploy/data/secure_graph.yaml' --name commands marker:=avsIntruder3" >"$W/intruder_writer.log" 2>&1 &
+PIDS+=($!)
+sleep 1
+out=$(echo_with "$W/secure.yaml" observer 8) && fail "a writer with another CA's identity reached the secure reader: $out"
+grep -q avsIntruder3 <<<"$out" && fail "a writer with another CA's identity reached the secure reader"
+echo "ok: a writer with an identity from another CA (and its own valid grant) does not reach the secure reader"
 
 # 5. the same traffic without security: the marker is on the wire
 kill -TERM "${PIDS[@]}" 2>/dev/null

@@ -5,6 +5,9 @@
 // With a deployment file (docs/deploy.md) and --host NAME it starts that host's containers
 // with the Cyclone configuration generated for the host, and reports when a topic its
 // containers read from other hosts loses its last publisher, and when one comes back.
+#include <arpa/inet.h>
+#include <ifaddrs.h>
+#include <net/if.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -262,6 +265,34 @@ std::map<std::string, std::string> remote_inputs(const deploy::Deployment& d,
   return out;
 }
 
+/// "" when this machine can be `host` (its interface exists, its address is local), else why
+/// not: starting with the wrong --host would send every container's traffic to the wrong place.
+std::string host_mismatch(const deploy::Host& host) {
+  if (host.interface.empty() && host.address.empty()) return "";
+  ifaddrs* list = nullptr;
+  if (getifaddrs(&list) != 0) return "";  // cannot tell; Cyclone will complain if wrong
+  bool interface_found = host.interface.empty(), address_found = host.address.empty();
+  std::string local;
+  for (ifaddrs* a = list; a != nullptr; a = a->ifa_next) {
+    if (a->ifa_name != nullptr && host.interface == a->ifa_name) interface_found = true;
+    if (a->ifa_addr == nullptr || a->ifa_addr->sa_family != AF_INET) continue;
+    char text[INET_ADDRSTRLEN] = {};
+    inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(a->ifa_addr)->sin_addr, text, sizeof text);
+    local += std::string(local.empty() ? "" : ", ") + a->ifa_name + " " + text;
+    if (host.address == text) address_found = true;
+  }
+  freeifaddrs(list);
+  if (!interface_found) {
+    return "host '" + host.name + "' uses interface '" + host.interface +
+           "', which this machine does not have (it has: " + local + ")";
+  }
+  if (!address_found) {
+    return "host '" + host.name + "' has address " + host.address +
+           ", which no interface of this machine holds (it has: " + local + ")";
+  }
+  return "";
+}
+
 int run_deployment(const std::string& file, const std::vector<std::string>& words,
                    const std::string& host_name) {
   std::vector<std::string> rest;
@@ -285,6 +316,10 @@ int run_deployment(const std::string& file, const std::vector<std::string>& word
   if (host == nullptr) {
     std::cerr << "avs launch: " << file << " has no host '" << host_name << "' (hosts: " << hosts
               << ")\n";
+    return 2;
+  }
+  if (const std::string why = host_mismatch(*host); !why.empty()) {
+    std::cerr << "avs launch: wrong --host? " << why << "\n";
     return 2;
   }
   if (host->containers.empty()) {
