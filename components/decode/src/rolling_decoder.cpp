@@ -59,20 +59,9 @@ std::unique_ptr<detail::SubcodeRefiner> make_refiner(const DecoderConfig& c) {
 /// Depth from fractional codes through the sub-code planes (NaN codes give NaN).
 void triangulate_subcode(const DepthTable& table, const float* refined, const DecoderConfig& c,
                          float* depth_out) {
-  const float* planes = table.subcode_planes();
-  const auto steps = static_cast<float>(table.subcode_steps());
-  const int count = table.subcode_plane_count();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  const float* rx = table.ray_x();
-  const float* ry = table.ray_y();
-  const int pixels = table.pixel_count();
-  for (int i = 0; i < pixels; ++i) {
-    const float position = (refined[i] + 0.5f) * steps + 0.5f;
-    const bool ok = position >= 0.0f && position < static_cast<float>(count);
-    const float* pl = planes + 4 * (ok ? static_cast<int>(position) : 0);
-    const float z = 1.0f / (pl[0] * rx[i] + pl[1] * ry[i] + pl[2]);
-    depth_out[i] = (ok && z > c.min_depth_m && z < c.max_depth_m) ? z : nan;
-  }
+  detail::triangulate_subcode(
+      refined, {table.subcode_planes(), table.subcode_steps(), table.subcode_plane_count()},
+      table.ray_x(), table.ray_y(), c.min_depth_m, c.max_depth_m, depth_out, table.pixel_count());
 }
 
 }  // namespace
@@ -274,11 +263,8 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
 
 void RollingDecoder::refine_depth(float* depth_out) {
   const auto full = static_cast<std::uint16_t>((1u << bit_count_) - 1u);
-  const int code_count = config_.geometry.layout.code_count;
-  for (std::size_t i = 0; i < codes_.size(); ++i) {
-    const int code = static_cast<int>(gray_to_binary(gray_[i]));
-    codes_[i] = static_cast<std::int16_t>(valid_[i] == full && code < code_count ? code : -1);
-  }
+  detail::codes_from_gray(gray_.data(), valid_.data(), full, config_.geometry.layout.code_count,
+                          codes_.data(), static_cast<int>(codes_.size()));
   refiner_->refine(codes_.data(), refined_codes_.data());
   triangulate_subcode(table_, refined_codes_.data(), config_, depth_out);
 }

@@ -31,8 +31,6 @@ class SubcodeRefiner {
   const SubcodeParams& params() const { return params_; }
 
  private:
-  void add_row(const std::int16_t* codes, int y, int sign);
-
   SubcodeParams params_;
   // Per column running sums over the window's valid codes (exact integers).
   std::vector<std::int32_t> n_, sy_, syy_, sc_, scy_, jumps_;
@@ -40,5 +38,22 @@ class SubcodeRefiner {
   std::vector<std::int16_t> previous_;    ///< per column: last valid code seen
   std::vector<std::int32_t> previous_y_;  ///< per column: its row
 };
+
+/// Binary code per pixel from the rolling window's Gray words, -1 unless every bit is known
+/// and the code is < code_count.
+void codes_from_gray(const std::uint16_t* gray, const std::uint16_t* valid, std::uint16_t full,
+                     int code_count, std::int16_t* codes, int pixels);
+
+struct SubcodePlanes {
+  const float* planes = nullptr;  ///< DepthTable::subcode_planes()
+  int steps = 0;                  ///< per code
+  int count = 0;                  ///< planes
+};
+
+/// Depth through the nearest sub-code plane of each fractional code (NaN codes, codes outside
+/// the table and depths outside (min, max) give NaN).
+void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
+                         const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
+                         int pixels);
 
 }  // namespace avs::decode::detail
