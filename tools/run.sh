@@ -15,11 +15,13 @@ DEMO_PACKAGES=(
   gnuplot-nox
 )
 # What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;
-# the MCAP fuzzer: clang; the independent MCAP reader: Node.js).
+# the MCAP fuzzer: clang; the independent MCAP reader: Node.js; the deployment tests: network
+# namespaces, openssl for DDS Security documents, iceoryx's RouDi for shared memory).
 TEST_PACKAGES=(
   libopencv-dev libpcl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang libclang-rt-14-dev nodejs
+  iproute2 openssl python3 iceoryx
 )
 BUILD_DIR=${AVS_BUILD_DIR:-build}
 # The demo builds only the `avs` program, without tests and benchmarks, in its own folder, so
