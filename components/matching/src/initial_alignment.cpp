@@ -1,6 +1,7 @@
 #include "avs/matching/initial_alignment.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -32,6 +33,11 @@ Eigen::Isometry3f lrf_transform(const Lrf& scene, const Lrf& model) {
   return t;
 }
 
+using Clock = std::chrono::steady_clock;
+float ms_since(Clock::time_point start) {
+  return std::chrono::duration<float, std::milli>(Clock::now() - start).count();
+}
+
 bool similar(const Eigen::Isometry3f& a, const Eigen::Isometry3f& b) {
   const Eigen::Matrix3f d = a.linear().transpose() * b.linear();
   return (a.translation() - b.translation()).norm() < 0.01F &&
@@ -40,11 +46,69 @@ bool similar(const Eigen::Isometry3f& a, const Eigen::Isometry3f& b) {
 
 }  // namespace
 
+namespace detail {
+
+// A coarse range image of the scene over the normalised image plane (x/z, y/z): per cell, the
+// nearest depth of the scene points splatted into it and its 8 neighbours (cells about one point
+// spacing wide, so the sparse S-PCD covers its silhouette without holes).
+class RangeImage {
+ public:
+  RangeImage(const Points& p_camera, float spacing_m) {
+    float z_sum = 0.0F;
+    Eigen::Vector2f low(std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
+    Eigen::Vector2f high = -low;
+    for (const auto& p : p_camera) {
+      z_sum += p.z();
+      const Eigen::Vector2f uv = p.head<2>() / p.z();
+      low = low.cwiseMin(uv);
+      high = high.cwiseMax(uv);
+    }
+    const float z_mean = z_sum / static_cast<float>(p_camera.size());
+    inverse_cell_ = z_mean / spacing_m;
+    origin_ = low.array() - 2.0F / inverse_cell_;
+    width_ = static_cast<int>((high.x() - origin_.x()) * inverse_cell_) + 3;
+    height_ = static_cast<int>((high.y() - origin_.y()) * inverse_cell_) + 3;
+    depth_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_),
+                  std::numeric_limits<float>::infinity());
+    for (const auto& p : p_camera) {
+      const int u = static_cast<int>((p.x() / p.z() - origin_.x()) * inverse_cell_);
+      const int v = static_cast<int>((p.y() / p.z() - origin_.y()) * inverse_cell_);
+      for (int dv = -1; dv <= 1; ++dv) {
+        for (int du = -1; du <= 1; ++du) {
+          float& cell = depth_[static_cast<std::size_t>((v + dv) * width_ + u + du)];
+          cell = std::min(cell, p.z());
+        }
+      }
+    }
+  }
+  /// Nearest scene depth along the ray of p; infinity where the scene shows nothing.
+  [[nodiscard]] float depth(const Eigen::Vector3f& p) const {
+    if (!(p.z() > 0.0F)) return std::numeric_limits<float>::infinity();
+    const float u = (p.x() / p.z() - origin_.x()) * inverse_cell_;
+    const float v = (p.y() / p.z() - origin_.y()) * inverse_cell_;
+    if (!(u >= 0.0F && v >= 0.0F && u < static_cast<float>(width_) &&
+          v < static_cast<float>(height_))) {
+      return std::numeric_limits<float>::infinity();
+    }
+    return depth_[static_cast<std::size_t>(static_cast<int>(v) * width_ + static_cast<int>(u))];
+  }
+
+ private:
+  std::vector<float> depth_;
+  Eigen::Vector2f origin_ = Eigen::Vector2f::Zero();
+  float inverse_cell_ = 1.0F;
+  int width_ = 0;
+  int height_ = 0;
+};
+
+}  // namespace detail
+
 InitialAligner::InitialAligner(const ModelCloud& model, InitialAlignmentConfig config)
     : config_(config),
       model_tree_(model.points_m),
       dense_tree_(model.dense_points_m.empty() ? model.points_m : model.dense_points_m),
       dense_normals_(model.dense_points_m.empty() ? model.normals : model.dense_normals),
+      distance_(dense_tree_.points(), config.distance_cell_m, config.score_truncation_m),
       refine_(model.points_m, refine_config(config), model.normals),
       verify_(
           dense_tree_.points(),
@@ -54,6 +118,7 @@ InitialAligner::InitialAligner(const ModelCloud& model, InitialAlignmentConfig c
             return icp;
           }(),
           dense_normals_) {
+  spacing_m_ = model.mean_spacing_m;
   config_.scene_features = with_radius(config_.scene_features, model.mean_spacing_m);
   config_.model_features = with_radius(config_.model_features, model.mean_spacing_m);
   // Principal axes of the model through its centroid, for the flip candidates.
@@ -80,11 +145,9 @@ InitialAligner::InitialAligner(const ModelCloud& model, InitialAlignmentConfig c
 
 float InitialAligner::score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
                             const Eigen::Isometry3f& T_model_camera, float give_up_above) const {
-  const float truncation_squared = config_.score_truncation_m * config_.score_truncation_m;
   float sum = 0.0F;
   for (const auto i : subset) {
-    const auto [index, squared] = model_tree_.nearest(T_model_camera * p_camera[i]);
-    sum += std::sqrt(std::min(squared, truncation_squared));
+    sum += distance_.nearest_distance(T_model_camera * p_camera[i]);
     if (sum > give_up_above) return std::numeric_limits<float>::infinity();
   }
   return sum;
@@ -96,6 +159,7 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   scene_lrfs_used_.clear();
   if (p_camera.size() < 10 || model_lrfs_.empty()) return result;
 
+  auto start = Clock::now();
   // 1. Scene features and LRFs (normals toward the camera at the origin).
   const KdTree scene_tree(p_camera);
   const PointFeatures features = compute_features(p_camera, scene_tree, config_.scene_features, {});
@@ -114,12 +178,17 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   order.resize(std::min(order.size(), wanted));
   for (const auto i : order) scene_lrfs_used_.push_back(scene_lrfs_[i]);
 
+  result.features_ms = ms_since(start);
+  start = Clock::now();
   // 3. Score every scene/model LRF pair by summed (truncated) closest-point distances on an
   //    evenly spread subset of the scene; keep the best few distinct hypotheses.
   std::vector<std::uint32_t> subset;
   const std::size_t step = std::max<std::size_t>(1, p_camera.size() / config_.score_points);
   for (std::size_t i = 0; i < p_camera.size(); i += step)
     subset.push_back(static_cast<std::uint32_t>(i));
+  // Random order: a partial sum then already samples the whole object, so a wrong hypothesis
+  // is abandoned after a few points.
+  std::shuffle(subset.begin(), subset.end(), rng);
   std::vector<Hypothesis> best;  // sorted ascending by score, at most refine_candidates * 4
   const std::size_t keep = std::max<std::size_t>(1, config_.refine_candidates) * 4;
   for (const auto& scene : scene_lrfs_used_) {
@@ -141,6 +210,8 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   result.model_lrfs = model_lrfs_.size();
   if (best.empty()) return result;
 
+  result.scoring_ms = ms_since(start);
+  start = Clock::now();
   // 4. Verify: refine distinct top hypotheses by ICP; score each by the mean truncated distance
   //    from every scene point to the model plus the mean truncated distance from every model
   //    point facing the camera to the scene (what the pose predicts must be seen), keep the best.
@@ -157,39 +228,103 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
     // T_model_camera of a flipped pose: flip^-1 applied in the model frame.
     for (const auto& flip : flips_model_) distinct.push_back(flip.inverse() * distinct[c]);
   }
-  const float verify_squared = config_.verify_truncation_m * config_.verify_truncation_m;
-  float best_score = std::numeric_limits<float>::infinity();
+  // 4a. Refine every candidate by ICP on the M-PCD and screen it by the mean truncated distance
+  //     from the scene to the dense model surface (tabulated).
+  std::vector<Hypothesis> screened;
+  screened.reserve(distinct.size());
   for (const auto& T_model_camera : distinct) {
     const IcpResult coarse = refine_.align(p_camera, T_model_camera.inverse());
-    const IcpResult refined = verify_.align(p_camera, coarse.T_camera_model);
-    const Eigen::Isometry3f T_camera_model = refined.T_camera_model;
-    const Eigen::Isometry3f T_refined = T_camera_model.inverse();
+    const Eigen::Isometry3f T_refined = coarse.T_camera_model.inverse();
     float sum = 0.0F;
-    for (const auto& p : p_camera) {
-      sum += std::sqrt(std::min(dense_tree_.nearest(T_refined * p).second, verify_squared));
-    }
-    float mean = sum / static_cast<float>(p_camera.size());
-    if (config_.visibility_weight > 0.0F) {
-      float visible_sum = 0.0F;
-      std::size_t visible = 0;
-      for (std::size_t i = 0; i < dense_tree_.size(); ++i) {
-        const Eigen::Vector3f p = T_camera_model * dense_tree_.points()[i];
-        if ((T_camera_model.linear() * dense_normals_[i]).dot(p) >= 0.0F) continue;  // faces away
-        visible_sum += std::sqrt(std::min(scene_tree.nearest(p).second, verify_squared));
-        ++visible;
-      }
-      if (visible > 0)
-        mean += config_.visibility_weight * visible_sum / static_cast<float>(visible);
-    }
-    if (mean < best_score) {
-      best_score = mean;
-      result.T_camera_model = T_camera_model;
-      result.rmse_m = refined.rmse_m;
+    for (const auto& p : p_camera)
+      sum += std::min(distance_.distance(T_refined * p), config_.verify_truncation_m);
+    screened.push_back({T_refined, sum / static_cast<float>(p_camera.size())});
+  }
+  std::sort(screened.begin(), screened.end(),
+            [](const Hypothesis& a, const Hypothesis& b) { return a.score < b.score; });
+  if (screened.size() > config_.verify_candidates) screened.resize(config_.verify_candidates);
+
+  // 4b. The best few: ICP on the dense samples, then the full score (scene term plus the
+  //     free-space and visibility terms), keep the best.
+  const detail::RangeImage range(p_camera, spacing_m_);
+  float best_score = std::numeric_limits<float>::infinity();
+  for (const auto& candidate : screened) {
+    const VerifiedPose verified =
+        verify(p_camera, scene_tree, range, candidate.T_model_camera.inverse());
+    if (verified.score_m < best_score) {
+      best_score = verified.score_m;
+      result.T_camera_model = verified.T_camera_model;
+      result.rmse_m = verified.rmse_m;
     }
   }
+  result.candidates = distinct.size();
   result.score_m = best_score;
+  result.verify_ms = ms_since(start);
   result.valid = true;
   return result;
+}
+
+VerifiedPose InitialAligner::verify(const Points& p_camera,
+                                    const Eigen::Isometry3f& T_camera_model_guess) {
+  if (p_camera.empty()) return {};
+  const KdTree scene_tree(p_camera);
+  const detail::RangeImage range(p_camera, spacing_m_);
+  return verify(p_camera, scene_tree, range, T_camera_model_guess);
+}
+
+VerifiedPose InitialAligner::verify(const Points& p_camera, const KdTree& scene_tree,
+                                    const detail::RangeImage& range,
+                                    const Eigen::Isometry3f& T_camera_model_guess) {
+  VerifiedPose out;
+  const IcpResult refined = verify_.align(p_camera, T_camera_model_guess);
+  out.T_camera_model = refined.T_camera_model;
+  out.rmse_m = refined.rmse_m;
+  const Eigen::Isometry3f& T_camera_model = out.T_camera_model;
+  const Eigen::Isometry3f T_model_camera = T_camera_model.inverse();
+  // Scene term: mean truncated distance from the scene to the dense model surface.
+  float sum = 0.0F;
+  for (const auto& p : p_camera)
+    sum += std::min(distance_.distance(T_model_camera * p), config_.verify_truncation_m);
+  out.scene_term_m = sum / static_cast<float>(p_camera.size());
+  out.score_m = out.scene_term_m;
+  // Model points the pose shows to the camera (normal toward it).
+  const auto faces_camera = [&](std::size_t i, const Eigen::Vector3f& p) {
+    return (T_camera_model.linear() * dense_normals_[i]).dot(p) < 0.0F;
+  };
+  if (config_.free_space_weight > 0.0F) {
+    // Free space: those points must not lie where the scene shows nothing or in front of the
+    // observed surface (hidden behind it is fine).
+    const float tolerance = config_.free_space_tolerance_m;
+    std::size_t counted = 0;
+    std::size_t violations = 0;
+    for (std::size_t i = 0; i < dense_tree_.size(); ++i) {
+      const Eigen::Vector3f p = T_camera_model * dense_tree_.points()[i];
+      if (!faces_camera(i, p)) continue;
+      const float observed = range.depth(p);
+      if (p.z() > observed + tolerance) continue;  // behind the observed surface
+      ++counted;
+      violations += p.z() < observed - tolerance ? 1U : 0U;
+    }
+    if (counted > 0)
+      out.free_space_violations = static_cast<float>(violations) / static_cast<float>(counted);
+    out.score_m +=
+        config_.free_space_weight * config_.verify_truncation_m * out.free_space_violations;
+  }
+  if (config_.visibility_weight > 0.0F) {
+    // Visibility: mean truncated distance from those points to the scene.
+    const float verify_squared = config_.verify_truncation_m * config_.verify_truncation_m;
+    float visible_sum = 0.0F;
+    std::size_t visible = 0;
+    for (std::size_t i = 0; i < dense_tree_.size(); ++i) {
+      const Eigen::Vector3f p = T_camera_model * dense_tree_.points()[i];
+      if (!faces_camera(i, p)) continue;
+      visible_sum += std::sqrt(std::min(scene_tree.nearest(p).second, verify_squared));
+      ++visible;
+    }
+    if (visible > 0)
+      out.score_m += config_.visibility_weight * visible_sum / static_cast<float>(visible);
+  }
+  return out;
 }
 
 }  // namespace avs::matching

@@ -1,5 +1,6 @@
 #include "avs/matching/scene_cloud.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,10 @@ void remove_outliers_into(const Points& in, std::size_t neighbours, float thresh
     out = in;
     return;
   }
+  // At most a twelfth of the cloud: in a small cloud (the ken seen edge-on, ~65 points after the
+  // voxel step) 20 neighbours reach across the object and a thin part (its spike) would be taken
+  // for outliers. Clouds of 240 points or more use `neighbours` as given.
+  neighbours = std::min(neighbours, std::max<std::size_t>(4, in.size() / 12));
   const KdTree tree(in);  // small (a few hundred points); the build is a few microseconds
   indices.resize(neighbours + 1);
   squared.resize(neighbours + 1);

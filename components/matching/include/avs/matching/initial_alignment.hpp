@@ -6,9 +6,11 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "avs/matching/cloud.hpp"
+#include "avs/matching/distance_grid.hpp"
 #include "avs/matching/features.hpp"
 #include "avs/matching/icp.hpp"
 #include "avs/matching/model_cloud.hpp"
@@ -16,19 +18,29 @@
 namespace avs::matching {
 
 struct InitialAlignmentConfig {
-  FeatureConfig scene_features;       ///< radius 0 = 2.5 x the model's mean point spacing
-  FeatureConfig model_features;       ///< radius 0 = 2.5 x the model's mean point spacing
-  float scene_lrf_rate = 0.1F;        ///< scene LRFs kept (paper: 0.1) ...
-  std::size_t min_scene_lrfs = 12;    ///< ... but at least this many when available
-  std::size_t score_points = 40;      ///< scene points that score each hypothesis
-  float score_truncation_m = 0.02F;   ///< closest-point distances are clamped to this
+  FeatureConfig scene_features;      ///< radius 0 = 2.5 x the model's mean point spacing
+  FeatureConfig model_features;      ///< radius 0 = 2.5 x the model's mean point spacing
+  float scene_lrf_rate = 0.1F;       ///< scene LRFs kept (paper: 0.1) ...
+  std::size_t min_scene_lrfs = 40;   ///< ... but at least this many when available
+  std::size_t score_points = 80;     ///< scene points that score each hypothesis
+  float score_truncation_m = 0.02F;  ///< closest-point distances are clamped to this
+  /// Cell of the tabulated closest-point distance to the dense model surface that scores the
+  /// hypotheses (DistanceGrid, built in the constructor).
+  float distance_cell_m = 0.002F;
   std::size_t refine_candidates = 6;  ///< best distinct hypotheses refined by ICP
   std::array<int, 3> refine_iterations{6, 6, 12};
+  /// Refined candidates (best by the scene-to-model distance) that get the dense verification.
+  std::size_t verify_candidates = 3;
   IcpMetric refine_metric = IcpMetric::point_to_plane;
   float verify_truncation_m = 0.01F;  ///< truncation of the final scores
   /// Weight of the visibility term: mean distance from the model points the refined pose shows
   /// to the camera to their closest scene points. It tells the ken's big cup from its small cup.
-  float visibility_weight = 0.5F;
+  float visibility_weight = 0.0F;
+  /// Weight of the free-space term: the fraction of the model points the refined pose shows to
+  /// the camera that lie where the scene shows nothing or in front of the observed surface
+  /// (times verify_truncation_m).
+  float free_space_weight = 1.0F;
+  float free_space_tolerance_m = 0.01F;           ///< depth margin of the free-space test
   std::array<int, 3> verify_iterations{0, 0, 5};  ///< ICP on the dense model before scoring
   /// The best few hypotheses are also tried turned by 180 degrees about each principal axis of
   /// the model (through its centroid): the end-for-end flips LRFs confuse.
@@ -43,8 +55,25 @@ struct InitialAlignmentResult {
   std::size_t scene_lrfs = 0;
   std::size_t model_lrfs = 0;
   std::size_t hypotheses = 0;  ///< LRF pairs scored
+  std::size_t candidates = 0;  ///< hypotheses refined and verified
+  float features_ms = 0.0F;    ///< wall time: scene features and LRFs (Eqs. 17-19)
+  float scoring_ms = 0.0F;     ///< wall time: LRF-pair scoring (Eq. 20)
+  float verify_ms = 0.0F;      ///< wall time: refinement and verification
   bool valid = false;          ///< false when the scene has too few points or LRFs
 };
+
+/// A pose after the verification's ICP on the dense model samples, and its score.
+struct VerifiedPose {
+  Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+  float score_m = std::numeric_limits<float>::infinity();  ///< lower is better
+  float scene_term_m = 0.0F;           ///< mean truncated scene-to-model distance
+  float free_space_violations = 0.0F;  ///< fraction of the shown model points in free space
+  float rmse_m = 0.0F;
+};
+
+namespace detail {
+class RangeImage;
+}
 
 /// Holds the model's features and LRFs (computed once) and aligns scenes to it.
 class InitialAligner {
@@ -52,6 +81,10 @@ class InitialAligner {
   explicit InitialAligner(const ModelCloud& model, InitialAlignmentConfig config = {});
 
   [[nodiscard]] InitialAlignmentResult align(const Points& p_camera);
+
+  /// The verification step alone from a given pose (for diagnostics and tests).
+  [[nodiscard]] VerifiedPose verify(const Points& p_camera,
+                                    const Eigen::Isometry3f& T_camera_model_guess);
 
   [[nodiscard]] const std::vector<Lrf>& model_lrfs() const { return model_lrfs_; }
   /// LRFs of the last scene (all, and the down-sampled ones used), for figures.
@@ -64,6 +97,9 @@ class InitialAligner {
     Eigen::Isometry3f T_model_camera;
     float score;
   };
+  [[nodiscard]] VerifiedPose verify(const Points& p_camera, const KdTree& scene_tree,
+                                    const detail::RangeImage& range,
+                                    const Eigen::Isometry3f& T_camera_model_guess);
   [[nodiscard]] float score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
                             const Eigen::Isometry3f& T_model_camera, float give_up_above) const;
 
@@ -71,6 +107,8 @@ class InitialAligner {
   KdTree model_tree_;
   KdTree dense_tree_;  // dense samples (the M-PCD itself when the model has none)
   Points dense_normals_;
+  DistanceGrid distance_;                         // truncated distance to the dense model surface
+  float spacing_m_ = 0.0F;                        // the M-PCD's mean point spacing
   std::array<Eigen::Isometry3f, 3> flips_model_;  // 180-degree turns about the principal axes
   std::vector<Lrf> model_lrfs_;
   std::vector<Lrf> scene_lrfs_;

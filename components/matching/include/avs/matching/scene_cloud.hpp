@@ -16,7 +16,8 @@ namespace avs::matching {
 struct SceneCloudConfig {
   std::size_t target_points = 250;  ///< i_number of Eq. 27 (paper: 250 ken, 350 cube, 300 cylinder)
   float voxel_size_m = 0.00757F;    ///< r (paper: 7.57 mm)
-  std::size_t outlier_neighbours = 20;    ///< neighbours averaged by the outlier test (paper: 20)
+  /// Neighbours averaged by the outlier test (paper: 20); at most a twelfth of the cloud.
+  std::size_t outlier_neighbours = 20;
   float outlier_mean_distance_m = 0.03F;  ///< drop a point whose mean neighbour distance is larger
   float min_depth_m = 0.05F;              ///< depths outside [min, max] are treated as invalid
   float max_depth_m = 10.0F;
@@ -50,7 +51,8 @@ class SceneCloudBuilder {
 /// Stride ratio C_p of Eq. 27 for M valid pixels and a target of i_number points.
 [[nodiscard]] double stride_ratio(std::size_t valid_pixels, std::size_t target_points);
 
-/// Removes points whose mean distance to their k nearest neighbours exceeds the threshold.
+/// Removes points whose mean distance to their k nearest neighbours exceeds the threshold
+/// (k = min(neighbours, max(4, size / 12))).
 [[nodiscard]] Points remove_outliers(const Points& points, std::size_t neighbours,
                                      float mean_distance_threshold_m);
 
