@@ -6,7 +6,10 @@
 // start position or follows the object by look_at (no servo here).
 // Exploration knobs (environment): AVS_MATCHING_DEBUG=1 prints every update; AVS_MATCHING_ICP=
 // "n1,n2,n3", AVS_MATCHING_LAG=<s> (lag compensation), AVS_MATCHING_LAGROT=1, AVS_MATCHING_P2P=1,
-// AVS_MATCHING_NOCV=1, AVS_MATCHING_INLIER=<ratio>, AVS_MATCHING_RMSE=<m> override the setup.
+// AVS_MATCHING_NOCV=1, AVS_MATCHING_INLIER=<ratio>, AVS_MATCHING_RMSE=<m> override the setup;
+// AVS_MATCHING_SUBCODE=<h> sets the decoder's subcode_half_window, AVS_MATCHING_DEPTH=truth
+// matches the renderer's ground-truth depth instead of the decoded one, AVS_MATCHING_STATIC=1
+// keeps the object at its start pose.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -45,6 +48,7 @@ struct Setup {
   double end_s = 2.7;               ///< 0.5 s rest, 2 s motion, a little after
   double evaluate_from_s = 0.1;     ///< error statistics from here (after the first windows)
   bool static_object = false;       ///< the object holds its start pose
+  bool decoder_age = false;         ///< pass the decoder's effective data age to the pipeline
 };
 
 Run run(const Setup& setup) {
@@ -62,7 +66,8 @@ Run run(const Setup& setup) {
                                                .toRotationMatrix() *
                                            motion.T_world_object_start.linear();
   }
-  if (setup.static_object) {
+  const bool decoder_age = setup.decoder_age || std::getenv("AVS_MATCHING_AGE") != nullptr;
+  if (setup.static_object || std::getenv("AVS_MATCHING_STATIC") != nullptr) {
     target.trajectory = std::make_shared<sim::StaticTrajectory>(motion.T_world_object_start);
   } else {
     target.trajectory = std::make_shared<sim::ManipulatorTrajectory>(motion);
@@ -105,6 +110,7 @@ Run run(const Setup& setup) {
                 &config.tracker.icp.iterations[1], &config.tracker.icp.iterations[2]);
   }
   if (const char* lag = std::getenv("AVS_MATCHING_LAG")) config.lag_compensation_s = std::atof(lag);
+  if (const char* w = std::getenv("AVS_MATCHING_VELWIN")) config.velocity_window_s = std::atof(w);
   if (const char* r = std::getenv("AVS_MATCHING_INLIER"))
     config.tracker.min_inlier_ratio = static_cast<float>(std::atof(r));
   if (const char* r = std::getenv("AVS_MATCHING_RMSE"))
@@ -148,8 +154,15 @@ Run run(const Setup& setup) {
     ++out.depth_updates;
     const float* depth_data =
         truth_depth ? simulator.renderer().depth_m().data() : depth.depth_m.data();
+    // The rolling map's information is effective_age_pairs pairs (2 frames each) plus half a
+    // frame older than the newest frame.
+    const double data_age_s = (depth.effective_age_pairs * 2.0 + 0.5) / sim_config.frame_rate_hz;
     const PipelineOutput result =
-        pipeline.process({depth_data, depth.width, depth.height, depth.width}, frame.truth.time_s);
+        decoder_age && !truth_depth
+            ? pipeline.process({depth_data, depth.width, depth.height, depth.width},
+                               frame.truth.time_s, data_age_s)
+            : pipeline.process({depth_data, depth.width, depth.height, depth.width},
+                               frame.truth.time_s);
     if (result.track.initialised_this_frame) out.initial_ms = result.processing_ms;
     if (std::getenv("AVS_MATCHING_DEBUG") != nullptr) {
       const PoseError e =
@@ -157,11 +170,18 @@ Run run(const Setup& setup) {
                      frame.truth.objects[0].T_camera_object.cast<float>(), object.symmetry);
       std::printf(
           "t %.3f px %zu pts %zu state %s init %d valid %d rmse %.2f mm inl %.2f err %.1f mm %.1f "
-          "deg\n",
+          "deg dxyz %.1f %.1f %.1f mm z %.1f mm\n",
           t, result.valid_pixels, result.scene_points, to_string(result.track.state),
           result.track.initialised_this_frame ? 1 : 0, result.track.pose_valid ? 1 : 0,
           1e3 * result.track.icp.rmse_m, result.track.icp.inlier_ratio(), 1e3 * e.translation_m,
-          e.rotation_deg);
+          e.rotation_deg,
+          1e3 * (result.track.T_camera_model.translation().x() -
+                 frame.truth.objects[0].T_camera_object.translation().x()),
+          1e3 * (result.track.T_camera_model.translation().y() -
+                 frame.truth.objects[0].T_camera_object.translation().y()),
+          1e3 * (result.track.T_camera_model.translation().z() -
+                 frame.truth.objects[0].T_camera_object.translation().z()),
+          1e3 * frame.truth.objects[0].T_camera_object.translation().z());
     }
     total_ms += result.processing_ms;
     if (!result.has_pose) continue;

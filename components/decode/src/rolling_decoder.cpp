@@ -288,6 +288,15 @@ DecodeResult RollingDecoder::make_result(bool updated) const {
   result.depth_m = depth_m_;
   result.points_camera_m = points_;
   result.stats = stats_;
+  const auto full = static_cast<std::uint16_t>((1u << bit_count_) - 1u);
+  if (newest_sequence_ >= 0 && fresh_mask() == full) {
+    const std::int64_t newest_pair = newest_sequence_ / 2;
+    double age = 0;
+    for (int k = 0; k < bit_count_; ++k) {
+      age += static_cast<double>(1u << k) * static_cast<double>(newest_pair - pair_of_bit_[k]);
+    }
+    result.effective_age_pairs = age / static_cast<double>(full);
+  }
   return result;
 }
 

@@ -57,6 +57,14 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
 }
 
 PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s) {
+  return process(depth, stamp_s, -1.0);
+}
+
+PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
+                                         double data_age_s) {
+  const bool aged = data_age_s >= 0.0;
+  const double lag_s = aged ? data_age_s : config_.lag_compensation_s;
+  const double data_stamp_s = aged ? stamp_s - data_age_s : stamp_s;
   const auto start = std::chrono::steady_clock::now();
   PipelineOutput out;
   scene_ = &builder_.build(depth, {}, config_.camera);
@@ -71,17 +79,16 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s)
     history_.clear();
   }
   if (out.track.pose_valid) {
-    history_.push_back({stamp_s, out.track.T_camera_model});
-    while (history_.size() > 2 && stamp_s - history_[1].stamp_s >= config_.velocity_window_s) {
+    history_.push_back({data_stamp_s, out.track.T_camera_model});
+    while (history_.size() > 2 && data_stamp_s - history_[1].stamp_s >= config_.velocity_window_s) {
       history_.pop_front();
     }
   }
-  if (config_.lag_compensation_s > 0.0 && out.has_pose && history_.size() >= 2) {
+  if (config_.lag_compensation_s > 0.0 && lag_s > 0.0 && out.has_pose && history_.size() >= 2) {
     const Stamped& older = history_.front();
     const Stamped& newer = history_.back();
-    out.T_camera_model =
-        extrapolate(older.T_camera_model, older.stamp_s, newer.T_camera_model, newer.stamp_s,
-                    config_.lag_compensation_s, config_.lag_compensate_rotation);
+    out.T_camera_model = extrapolate(older.T_camera_model, older.stamp_s, newer.T_camera_model,
+                                     newer.stamp_s, lag_s, config_.lag_compensate_rotation);
     out.lag_compensated = true;
   }
   out.processing_ms =

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <vector>
@@ -88,6 +89,12 @@ struct DecodeResult {
   /// DecoderConfig::compute_point_map.
   std::span<const Eigen::Vector3f> points_camera_m;
   DecoderStats stats;
+  /// How old the map's depth information is on average, in pairs before the newest pair: the
+  /// ages of the window's bits weighted by how many code transitions each bit decides (bit k,
+  /// 0 = MSB, flips at 2^k of the 2^n - 1 Gray-code transitions), so mostly the finest bits'.
+  /// A moving surface's decoded depth lags the newest frame by about this times 2 frame
+  /// periods (+ half a frame period: a pair's mid-time); docs/decode.md. NaN before a full window.
+  double effective_age_pairs = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Algorithm 1 on one Gray word: writes bit k (0 = MSB) of an n-bit word and, when that bit

@@ -56,6 +56,12 @@ class MatchingPipeline {
 
   /// One depth image (metres, NaN or 0 invalid) taken at stamp_s.
   PipelineOutput process(const DepthView& depth, double stamp_s);
+  /// Same for a depth image whose information is data_age_s older than stamp_s (a rolling
+  /// map: decode::DecodeResult::effective_age_pairs x 2 frame periods + half a period). The
+  /// velocity history is kept at stamp_s - data_age_s and, when lag_compensation_s > 0, the
+  /// published pose is extrapolated by data_age_s (instead of the constant lag_compensation_s)
+  /// to stamp_s.
+  PipelineOutput process(const DepthView& depth, double stamp_s, double data_age_s);
 
   void reset() { tracker_.reset(); }
   [[nodiscard]] const Points& scene_points() const { return *scene_; }
