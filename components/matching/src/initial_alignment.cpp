@@ -145,10 +145,21 @@ InitialAligner::InitialAligner(const ModelCloud& model, InitialAlignmentConfig c
 
 float InitialAligner::score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
                             const Eigen::Isometry3f& T_model_camera, float give_up_above) const {
+  // The subset is in random order, so after k of n points the partial sum estimates k/n of the
+  // total: a hypothesis whose first `probe` points already cost more than `slack` times their
+  // share of the current limit is abandoned too (early termination of the pair scoring).
+  const std::size_t probe = config_.score_probe_points;
+  const float slack = config_.score_probe_slack;
+  const std::size_t n = subset.size();
+  const float probe_limit =
+      std::isfinite(give_up_above) && n > probe
+          ? slack * give_up_above * static_cast<float>(probe) / static_cast<float>(n)
+          : std::numeric_limits<float>::infinity();
   float sum = 0.0F;
-  for (const auto i : subset) {
-    sum += distance_.nearest_distance(T_model_camera * p_camera[i]);
-    if (sum > give_up_above) return std::numeric_limits<float>::infinity();
+  for (std::size_t k = 0; k < n; ++k) {
+    sum += distance_.nearest_distance(T_model_camera * p_camera[subset[k]]);
+    if (sum > give_up_above || (k + 1 == probe && sum > probe_limit))
+      return std::numeric_limits<float>::infinity();
   }
   return sum;
 }

@@ -24,6 +24,10 @@ struct InitialAlignmentConfig {
   std::size_t min_scene_lrfs = 40;   ///< ... but at least this many when available
   std::size_t score_points = 80;     ///< scene points that score each hypothesis
   float score_truncation_m = 0.02F;  ///< closest-point distances are clamped to this
+  /// Early termination: a hypothesis whose first score_probe_points (random) points cost more
+  /// than score_probe_slack times their share of the current limit is abandoned.
+  std::size_t score_probe_points = 16;
+  float score_probe_slack = 1.5F;
   /// Cell of the tabulated closest-point distance to the dense model surface that scores the
   /// hypotheses (DistanceGrid, built in the constructor).
   float distance_cell_m = 0.002F;
@@ -34,11 +38,12 @@ struct InitialAlignmentConfig {
   IcpMetric refine_metric = IcpMetric::point_to_plane;
   float verify_truncation_m = 0.01F;  ///< truncation of the final scores
   /// Weight of the visibility term: mean distance from the model points the refined pose shows
-  /// to the camera to their closest scene points. It tells the ken's big cup from its small cup.
+  /// to the camera to their closest scene points (self-occluded points count too; superseded
+  /// by the free-space term, off by default).
   float visibility_weight = 0.0F;
   /// Weight of the free-space term: the fraction of the model points the refined pose shows to
   /// the camera that lie where the scene shows nothing or in front of the observed surface
-  /// (times verify_truncation_m).
+  /// (times verify_truncation_m). It tells the ken's big cup from its small cup.
   float free_space_weight = 1.0F;
   float free_space_tolerance_m = 0.01F;           ///< depth margin of the free-space test
   std::array<int, 3> verify_iterations{0, 0, 5};  ///< ICP on the dense model before scoring
