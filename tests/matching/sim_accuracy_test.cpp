@@ -48,7 +48,12 @@ struct Setup {
   double end_s = 2.7;               ///< 0.5 s rest, 2 s motion, a little after
   double evaluate_from_s = 0.1;     ///< error statistics from here (after the first windows)
   bool static_object = false;       ///< the object holds its start pose
-  bool decoder_age = false;         ///< pass the decoder's effective data age to the pipeline
+  /// The decoder's sub-code refinement (DecoderConfig::subcode_half_window; 0 = code centres).
+  int subcode_half_window = 4;
+  /// Pass the decoder's effective data age to the pipeline, which keeps its velocity history at
+  /// the data's time and extrapolates the published pose by that age (translation only).
+  bool decoder_age = true;
+  double velocity_window_s = 0.03;  ///< MatchingPipeline::velocity_window_s
 };
 
 Run run(const Setup& setup) {
@@ -78,6 +83,7 @@ Run run(const Setup& setup) {
 
   decode::DecoderConfig decoder_config;
   decoder_config.geometry = sim_config.renderer.geometry;
+  decoder_config.subcode_half_window = setup.subcode_half_window;
   if (const char* h = std::getenv("AVS_MATCHING_SUBCODE")) {
     decoder_config.subcode_half_window = std::atoi(h);
   }
@@ -101,6 +107,10 @@ Run run(const Setup& setup) {
                    lens.height};
   config.scene.target_points = object.scene_points;
   config.lag_compensation_s = setup.lag_compensation_s;
+  config.velocity_window_s = setup.velocity_window_s;
+  // With the decoder's age the extrapolation horizon is that age; lag_compensation_s > 0 is the
+  // switch (MatchingPipeline::process with data_age_s).
+  if (setup.decoder_age) config.lag_compensation_s = std::max(config.lag_compensation_s, 0.009);
   config.tracker.icp.metric = object.metric;
   config.tracker.max_rmse_m = 0.015F;
   config.tracker.min_inlier_ratio = 0.3F;
@@ -132,7 +142,10 @@ Run run(const Setup& setup) {
       setup.object + (setup.static_object ? " static" : " manipulator") +
       (setup.follow ? ", head follows" : ", head still") +
       (setup.lag_compensation_s > 0 ? ", lag comp " : "") +
-      (setup.lag_compensation_s > 0 ? std::to_string(setup.lag_compensation_s * 1e3) + " ms" : "");
+      (setup.lag_compensation_s > 0 ? std::to_string(setup.lag_compensation_s * 1e3) + " ms" : "") +
+      (setup.subcode_half_window > 0 ? ", sub-code h " + std::to_string(setup.subcode_half_window)
+                                     : ", code centres") +
+      (setup.decoder_age ? ", age comp" : "");
   double total_ms = 0;
   const int frames = static_cast<int>(setup.end_s * sim_config.frame_rate_hz);
   const int window = 2 * decoder_config.geometry.layout.bit_count;
@@ -233,11 +246,11 @@ Run run(const Setup& setup) {
 }
 
 // Issue 6's goals: position RMS <= 3 mm, orientation RMS <= 2 deg, zero flips, a pose per
-// 500 Hz depth update. The last two hold and are asserted. The RMS goals are NOT met through the
-// rolling decoder (a static ken already shows ~2.8 mm / 2.3 deg: the decoder triangulates code
-// centres, 19 mm depth steps at 1 m; moving, the 18-frame window adds ~10 ms of lag); the test
-// prints them and asserts bounds just above today's figures so a regression fails
-// (docs/matching.md).
+// 500 Hz depth update. A pose per update and zero flips are asserted; the RMS figures are
+// printed beside the goals and bounded just above today's figures so that a regression fails
+// (docs/matching.md, docs/decode.md). The setup is the decoder's sub-code refinement (h = 4)
+// and the decoder's data age passed to the pipeline; the plain path (code centres, no age) is
+// kept as one more run of the ken with its older bounds.
 void check(const Setup& setup, double max_position_rms_mm, double max_rotation_rms_deg) {
   const Run r = run(setup);
   const int frames = static_cast<int>(setup.end_s * 1000.0);
@@ -254,14 +267,30 @@ void check(const Setup& setup, double max_position_rms_mm, double max_rotation_r
 
 // Section 7.2.1: the ken on the manipulator (pi/2 about Z, pi/4 about Y, -pi/4 about Z in 2 s).
 TEST(SimAccuracy, KenOnTheManipulatorTrajectory) {
-  check({.object = "ken", .follow = true}, 12.0, 10.0);
+  check({.object = "ken", .follow = true}, 4.5, 3.5);
 }
 // Sections 7.2.2 and 7.2.3 give no motion: the same manipulator motion.
 TEST(SimAccuracy, CubeOnTheManipulatorTrajectory) {
-  check({.object = "cube", .follow = true}, 8.0, 4.0);
+  check({.object = "cube", .follow = true}, 2.0, 2.0);
 }
+// The cylinder on code centres (with the decoder's age): on refined depth the initial alignment
+// takes the axis ~88 degrees wrong at the start pose (also on the renderer's true depth,
+// AVS_MATCHING_DEPTH=truth) and ICP holds it until the motion shows the axis (~0.9 s).
 TEST(SimAccuracy, CylinderOnTheManipulatorTrajectory) {
-  check({.object = "cylinder", .follow = true}, 8.0, 5.0);
+  check({.object = "cylinder", .follow = true, .subcode_half_window = 0}, 6.5, 5.0);
+}
+// Enable when the cylinder's initial alignment is robust: the issue's goals on refined depth.
+TEST(SimAccuracy, DISABLED_CylinderOnRefinedDepth) {
+  check({.object = "cylinder", .follow = true}, 3.0, 2.0);
+}
+// The plain decoder path: code centres, pose published as matched.
+TEST(SimAccuracy, KenWithCodeCentresAndNoAgeCompensation) {
+  check({.object = "ken",
+         .follow = true,
+         .subcode_half_window = 0,
+         .decoder_age = false,
+         .velocity_window_s = 0.01},
+        12.0, 10.0);
 }
 
 }  // namespace
