@@ -99,6 +99,14 @@ Accuracy decode_and_report(const DecoderConfig& config, const SyntheticScene& sc
   return a;
 }
 
+void add_lens_distortion(DecoderConfig& config) {
+  config.geometry.camera.k1 = -0.12;
+  config.geometry.camera.k2 = 0.05;
+  config.geometry.camera.p1 = 0.001;
+  config.geometry.projector.k1 = 0.08;
+  config.geometry.projector.k2 = -0.02;
+}
+
 TEST(DepthAccuracy, PlaneAtOneMetreTableTriangulation) {
   DecoderConfig config;
   const auto scene = render_plane(config.geometry, plane_at_one_metre());
@@ -114,11 +122,7 @@ TEST(DepthAccuracy, PlaneAtOneMetreReferenceSolve) {
 
 TEST(DepthAccuracy, PlaneAtOneMetreWithLensDistortion) {
   DecoderConfig config;
-  config.geometry.camera.k1 = -0.12;
-  config.geometry.camera.k2 = 0.05;
-  config.geometry.camera.p1 = 0.001;
-  config.geometry.projector.k1 = 0.08;
-  config.geometry.projector.k2 = -0.02;
+  add_lens_distortion(config);
   const auto scene = render_plane(config.geometry, plane_at_one_metre());
   // The fitted planes approximate the curved rows of a distorted projector: a little above
   // pure quantisation noise, still well inside one code step.
@@ -140,11 +144,7 @@ TEST(DepthAccuracy, PlaneAtOneMetreSubcodeRefinement) {
 
 TEST(DepthAccuracy, PlaneAtOneMetreSubcodeRefinementWithLensDistortion) {
   DecoderConfig config;
-  config.geometry.camera.k1 = -0.12;
-  config.geometry.camera.k2 = 0.05;
-  config.geometry.camera.p1 = 0.001;
-  config.geometry.projector.k1 = 0.08;
-  config.geometry.projector.k2 = -0.02;
+  add_lens_distortion(config);
   config.subcode_half_window = 4;
   const auto scene = render_plane(config.geometry, plane_at_one_metre());
   decode_and_report(config, scene, "table, distorted lenses, sub-code h = 4", 0.85);
