@@ -32,7 +32,7 @@ struct InitialAlignmentConfig {
   /// hypotheses (DistanceGrid, built in the constructor).
   float distance_cell_m = 0.002F;
   std::size_t refine_candidates = 6;  ///< best distinct hypotheses refined by ICP
-  std::array<int, 3> refine_iterations{6, 6, 12};
+  std::array<int, 3> refine_iterations{4, 4, 6};
   /// Refined candidates (best by the scene-to-model distance) that get the dense verification.
   std::size_t verify_candidates = 3;
   IcpMetric refine_metric = IcpMetric::point_to_plane;
