@@ -45,7 +45,7 @@ TEST(ClosedLoop, TrackingKeepsTheSwingingTargetInViewAndHoldingStillLosesIt) {
       fs::temp_directory_path() / ("avs-tracking-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string json_file = dir.string() + ".json";
-  const std::string command = std::string(AVS_PROGRAM) +
+  const std::string command = "AVS_DOMAIN_ID=191 " + std::string(AVS_PROGRAM) +
                               " experiments tracking no_tracking --json --out " + dir.string() +
                               " > " + json_file + " 2> " + dir.string() + ".log";
   const int status = std::system(command.c_str());
