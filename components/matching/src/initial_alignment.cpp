@@ -53,17 +53,22 @@ namespace detail {
 // spacing wide, so the sparse S-PCD covers its silhouette without holes).
 class RangeImage {
  public:
+  static constexpr float kMinDepthM = 1e-3F;  // points closer (or behind the camera) are ignored
   RangeImage(const Points& p_camera, float spacing_m) {
     float z_sum = 0.0F;
+    std::size_t in_front = 0;
     Eigen::Vector2f low(std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
     Eigen::Vector2f high = -low;
     for (const auto& p : p_camera) {
+      if (!(p.z() > kMinDepthM)) continue;
       z_sum += p.z();
+      ++in_front;
       const Eigen::Vector2f uv = p.head<2>() / p.z();
       low = low.cwiseMin(uv);
       high = high.cwiseMax(uv);
     }
-    const float z_mean = z_sum / static_cast<float>(p_camera.size());
+    if (in_front == 0 || !(spacing_m > 0.0F)) return;  // empty: the scene shows nothing
+    const float z_mean = z_sum / static_cast<float>(in_front);
     inverse_cell_ = z_mean / spacing_m;
     origin_ = low.array() - 2.0F / inverse_cell_;
     width_ = static_cast<int>((high.x() - origin_.x()) * inverse_cell_) + 3;
@@ -71,6 +76,7 @@ class RangeImage {
     depth_.assign(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_),
                   std::numeric_limits<float>::infinity());
     for (const auto& p : p_camera) {
+      if (!(p.z() > kMinDepthM)) continue;
       const int u = static_cast<int>((p.x() / p.z() - origin_.x()) * inverse_cell_);
       const int v = static_cast<int>((p.y() / p.z() - origin_.y()) * inverse_cell_);
       for (int dv = -1; dv <= 1; ++dv) {
@@ -83,7 +89,7 @@ class RangeImage {
   }
   /// Nearest scene depth along the ray of p; infinity where the scene shows nothing.
   [[nodiscard]] float depth(const Eigen::Vector3f& p) const {
-    if (!(p.z() > 0.0F)) return std::numeric_limits<float>::infinity();
+    if (!(p.z() > kMinDepthM)) return std::numeric_limits<float>::infinity();
     const float u = (p.x() / p.z() - origin_.x()) * inverse_cell_;
     const float v = (p.y() / p.z() - origin_.y()) * inverse_cell_;
     if (!(u >= 0.0F && v >= 0.0F && u < static_cast<float>(width_) &&
