@@ -229,9 +229,9 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
 
   result.scoring_ms = ms_since(start);
   start = Clock::now();
-  // 4. Verify: refine distinct top hypotheses by ICP; score each by the mean truncated distance
-  //    from every scene point to the model plus the mean truncated distance from every model
-  //    point facing the camera to the scene (what the pose predicts must be seen), keep the best.
+  // 4. Verify: the best distinct hypotheses, and the best few turned end-for-end, are refined by
+  //    ICP and screened by the scene's distance to the model; the best of those are scored by
+  //    that distance plus what the pose predicts must be seen (free space), the best kept.
   std::vector<Eigen::Isometry3f> distinct;
   for (const auto& h : best) {
     if (distinct.size() >= config_.refine_candidates) break;
@@ -252,10 +252,7 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   for (const auto& T_model_camera : distinct) {
     const IcpResult coarse = refine_.align(p_camera, T_model_camera.inverse());
     const Eigen::Isometry3f T_refined = coarse.T_camera_model.inverse();
-    float sum = 0.0F;
-    for (const auto& p : p_camera)
-      sum += std::min(distance_.distance(T_refined * p), config_.verify_truncation_m);
-    screened.push_back({T_refined, sum / static_cast<float>(p_camera.size())});
+    screened.push_back({T_refined, scene_distance(p_camera, T_refined)});
   }
   std::sort(screened.begin(), screened.end(),
             [](const Hypothesis& a, const Hypothesis& b) { return a.score < b.score; });
@@ -281,6 +278,15 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   return result;
 }
 
+float InitialAligner::scene_distance(const Points& p_camera,
+                                     const Eigen::Isometry3f& T_model_camera) const {
+  // Mean truncated distance from the scene to the dense model surface (interpolated table).
+  float sum = 0.0F;
+  for (const auto& p : p_camera)
+    sum += std::min(distance_.distance(T_model_camera * p), config_.verify_truncation_m);
+  return sum / static_cast<float>(p_camera.size());
+}
+
 VerifiedPose InitialAligner::verify(const Points& p_camera,
                                     const Eigen::Isometry3f& T_camera_model_guess) {
   if (p_camera.empty()) return {};
@@ -298,11 +304,7 @@ VerifiedPose InitialAligner::verify(const Points& p_camera, const KdTree& scene_
   out.rmse_m = refined.rmse_m;
   const Eigen::Isometry3f& T_camera_model = out.T_camera_model;
   const Eigen::Isometry3f T_model_camera = T_camera_model.inverse();
-  // Scene term: mean truncated distance from the scene to the dense model surface.
-  float sum = 0.0F;
-  for (const auto& p : p_camera)
-    sum += std::min(distance_.distance(T_model_camera * p), config_.verify_truncation_m);
-  out.scene_term_m = sum / static_cast<float>(p_camera.size());
+  out.scene_term_m = scene_distance(p_camera, T_model_camera);
   out.score_m = out.scene_term_m;
   // Model points the pose shows to the camera (normal toward it).
   const auto faces_camera = [&](std::size_t i, const Eigen::Vector3f& p) {

@@ -1,6 +1,8 @@
 // Initial (global) alignment by local reference frames (paper section 6.1, Eqs. 17-20), then
-// verification: the best LRF-pair hypotheses are refined by ICP and re-scored on the whole
-// S-PCD, so a flipped match (the ken's big cup on its small cup) loses to the right one.
+// verification: the best LRF-pair hypotheses (and their end-for-end turns) are refined by ICP
+// and re-scored on the whole S-PCD against the dense model surface, with a free-space term (model
+// surface the pose shows where the scene has none), so a flipped match (the ken's big cup on its
+// small cup) loses to the right one.
 #pragma once
 
 #include <array>
@@ -105,6 +107,8 @@ class InitialAligner {
   [[nodiscard]] VerifiedPose verify(const Points& p_camera, const KdTree& scene_tree,
                                     const detail::RangeImage& range,
                                     const Eigen::Isometry3f& T_camera_model_guess);
+  [[nodiscard]] float scene_distance(const Points& p_camera,
+                                     const Eigen::Isometry3f& T_model_camera) const;
   [[nodiscard]] float score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
                             const Eigen::Isometry3f& T_model_camera, float give_up_above) const;
 
