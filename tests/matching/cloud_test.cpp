@@ -163,6 +163,12 @@ TEST(DistanceGrid, AgreesWithTheClosestPoint) {
   EXPECT_FLOAT_EQ(grid.distance(Eigen::Vector3f(1.0F, 0.0F, 0.0F)), truncation);
   EXPECT_FLOAT_EQ(grid.nearest_distance(Eigen::Vector3f(0.0F, -1.0F, 0.0F)), truncation);
   EXPECT_THROW(DistanceGrid(Points{}, cell, truncation), std::invalid_argument);
+  // A 2 m object: the cell grows so the table stays within the limit.
+  const DistanceGrid large(Points{{0.0F, 0.0F, 0.0F}, {2.0F, 2.0F, 2.0F}}, cell, truncation,
+                           1U << 20);
+  EXPECT_GT(large.cell_m(), cell);
+  EXPECT_LE(large.cells(), (1U << 20) + (1U << 18));  // + the boundary corners
+  EXPECT_NEAR(large.nearest_distance(Eigen::Vector3f(2.0F, 2.0F, 2.01F)), 0.01F, large.cell_m());
   EXPECT_THROW(DistanceGrid(model.dense_points_m, 0.0F, truncation), std::invalid_argument);
 }
 

@@ -9,7 +9,8 @@
 
 namespace avs::matching {
 
-DistanceGrid::DistanceGrid(const Points& points_m, float cell_m, float truncation_m)
+DistanceGrid::DistanceGrid(const Points& points_m, float cell_m, float truncation_m,
+                           std::size_t max_cells)
     : cell_m_(cell_m),
       inverse_cell_(1.0F / cell_m),
       truncation_m_(truncation_m),
@@ -28,6 +29,13 @@ DistanceGrid::DistanceGrid(const Points& points_m, float cell_m, float truncatio
   }
   origin_m_ = low.array() - truncation_m;
   const Eigen::Vector3f extent = (high - low).array() + 2.0F * truncation_m;
+  // A large object: coarser cells, so the table keeps at most max_cells corners.
+  const double volume = static_cast<double>(extent.x()) * extent.y() * extent.z();
+  if (max_cells > 0 &&
+      volume / std::pow(static_cast<double>(cell_m_), 3.0) > static_cast<double>(max_cells)) {
+    cell_m_ = static_cast<float>(std::cbrt(volume / static_cast<double>(max_cells)));
+    inverse_cell_ = 1.0F / cell_m_;
+  }
   const auto corners = [&](float length) {
     return static_cast<std::size_t>(std::ceil(length * inverse_cell_)) + 2;
   };
@@ -45,8 +53,8 @@ DistanceGrid::DistanceGrid(const Points& points_m, float cell_m, float truncatio
     for (std::size_t y = 0; y < ny_; ++y) {
       for (std::size_t x = 0; x < nx_; ++x, ++at) {
         const Eigen::Vector3f corner =
-            origin_m_ + cell_m * Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y),
-                                                 static_cast<float>(z));
+            origin_m_ + cell_m_ * Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y),
+                                                  static_cast<float>(z));
         const float squared = tree.nearest(corner).second;
         const float distance = std::sqrt(std::min(squared, truncation_squared));
         values_[at] = static_cast<std::uint8_t>(std::lround(distance / step_m_));

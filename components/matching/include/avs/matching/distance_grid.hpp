@@ -19,7 +19,12 @@ class DistanceGrid {
  public:
   DistanceGrid() = default;
   /// Throws std::invalid_argument for an empty point set or a non-positive cell or truncation.
-  DistanceGrid(const Points& points_m, float cell_m, float truncation_m);
+  /// The cell grows (cell_m() tells) when the table would have more than max_cells corners
+  /// (0: no limit), so a large mesh does not cost its cube in memory and build time.
+  DistanceGrid(const Points& points_m, float cell_m, float truncation_m,
+               std::size_t max_cells = kDefaultMaxCells);
+
+  static constexpr std::size_t kDefaultMaxCells = std::size_t{4} << 20;  ///< 4 MiB of 8-bit corners
 
   [[nodiscard]] bool empty() const { return values_.empty(); }
   [[nodiscard]] float truncation_m() const { return truncation_m_; }
