@@ -244,15 +244,17 @@ std::string fig14(const std::string& head, const std::vector<CloudSnapshot>& clo
   return s.str();
 }
 
-/// Robust colour range of the valid depths (2nd to 98th percentile).
+/// Colour range of the valid depths, 0.1st to 99.9th percentile: a small near target (the ken
+/// covers ~2 % of the image before a wall) keeps its own colour, single stray pixels do not
+/// stretch the scale.
 bool depth_range(const DepthSnapshot& depth, double& lo_m, double& hi_m) {
   std::vector<double> valid;
   for (const float d : depth.depth_m) {
     if (std::isfinite(d) && d > 0.0F) valid.push_back(d);
   }
   if (valid.empty()) return false;
-  lo_m = percentile(valid, 2.0);
-  hi_m = percentile(valid, 98.0);
+  lo_m = percentile(valid, 0.1);
+  hi_m = percentile(valid, 99.9);
   if (!(hi_m > lo_m)) {
     lo_m -= 0.01;
     hi_m += 0.01;
