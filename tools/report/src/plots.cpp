@@ -222,23 +222,23 @@ std::string fig14(const std::string& head, const std::vector<CloudSnapshot>& clo
   for (std::size_t i = 0; i < shown; ++i) {
     chosen.push_back(shown == 1 ? 0 : i * (n - 1) / (shown - 1));
   }
+  // Seen from the camera (x right, y down, equal scales): the paper's Fig. 14 overlays the
+  // model on the scene the same way. 3-D views at this size were unreadable.
   std::ostringstream s;
-  const std::size_t rows = shown > 2 ? 2 : 1;
-  const std::size_t cols = (shown + rows - 1) / rows;
-  s << head << "set multiplot layout " << rows << "," << cols
-    << " title 'Model (M-PCD at the estimated pose, red) over scene (S-PCD, blue) (cf. paper Fig. "
-       "14)'\n"
-    << "set view equal xyz\nset view 65,30\nset ticslevel 0\nunset key\n"
-    << "set tics font ',7'\n"
-    << "set xlabel 'x [m]'\nset ylabel 'y [m]'\nset zlabel 'z [m]'\n";
+  s << head << "set multiplot layout 1," << shown
+    << " title 'Model (M-PCD at the estimated pose, red) over scene (S-PCD, blue), camera view "
+       "(cf. paper Fig. 14)'\n"
+    << "set size ratio -1\nunset key\nset tics font ',8'\nset grid\nset xtics 0.02\nset ytics "
+       "0.02\n"
+    << "set xlabel 'x [m]'\nset ylabel 'y [m] (down)'\nset yrange [*:*] reverse\n";
   for (const std::size_t k : chosen) {
     s << "set title 't = " << clouds[k].t_s << " s'\n"
-      << "splot '" << kCloudsSnapshotFile << "' using (column('snapshot') == " << k
-      << " && strcol('cloud') eq 'scene' ? column('x_m') : NaN):'y_m':'z_m' with points pt 7 "
-         "ps 0.35 lc rgb '#1f77b4' title 'scene',\\\n"
-      << "      '' using (column('snapshot') == " << k
-      << " && strcol('cloud') eq 'model' ? column('x_m') : NaN):'y_m':'z_m' with points pt 6 "
-         "ps 0.4 lc rgb '#d62728' title 'model'\n";
+      << "plot '" << kCloudsSnapshotFile << "' using (column('snapshot') == " << k
+      << " && strcol('cloud') eq 'scene' ? column('x_m') : NaN):'y_m' with points pt 7 "
+         "ps 0.5 lc rgb '#1f77b4' title 'scene',\\\n"
+      << "     '' using (column('snapshot') == " << k
+      << " && strcol('cloud') eq 'model' ? column('x_m') : NaN):'y_m' with points pt 6 "
+         "ps 0.5 lc rgb '#d62728' title 'model'\n";
   }
   s << "unset multiplot\n";
   return s.str();
