@@ -16,28 +16,20 @@
 
 #include <gtest/gtest.h>
 
+#include "avs_program.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using avs::testing::read_file;
 
 /// The number for `key` inside the object of `scenario` in the experiments JSON.
 double figure(const std::string& json, const std::string& scenario, const std::string& key) {
   const auto start = json.find("\"" + scenario + "\": {");
   if (start == std::string::npos) throw std::runtime_error("no scenario " + scenario);
   const auto end = json.find('}', start);
-  const std::string object = json.substr(start, end - start);
-  const std::regex re("\"" + key + "\":\\s*(null|[-0-9.eE+]+)");
-  std::smatch m;
-  if (!std::regex_search(object, m, re)) throw std::runtime_error("no key " + key);
-  if (m[1] == "null") return std::nan("");
-  return std::stod(m[1]);
+  return avs::testing::json_number(json.substr(start, end - start), key);
 }
 
 TEST(ClosedLoop, TrackingKeepsTheSwingingTargetInViewAndHoldingStillLosesIt) {
@@ -45,13 +37,11 @@ TEST(ClosedLoop, TrackingKeepsTheSwingingTargetInViewAndHoldingStillLosesIt) {
       fs::temp_directory_path() / ("avs-tracking-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string json_file = dir.string() + ".json";
-  const std::string command = "AVS_DOMAIN_ID=191 " + std::string(AVS_PROGRAM) +
-                              " experiments tracking no_tracking --json --out " + dir.string() +
-                              " > " + json_file + " 2> " + dir.string() + ".log";
-  const int status = std::system(command.c_str());
+  const int status =
+      avs::testing::run_avs("experiments tracking no_tracking --json --out " + dir.string(), 191,
+                            json_file, dir.string() + ".log");
   const std::string json = read_file(json_file);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
-      << json << read_file(dir.string() + ".log");
+  ASSERT_EQ(status, 0) << json << read_file(dir.string() + ".log");
 
   const double on_in_view = figure(json, "tracking", "in_view_fraction");
   const double on_rms = figure(json, "tracking", "centroid_error_px_rms");

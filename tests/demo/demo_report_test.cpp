@@ -17,17 +17,14 @@
 
 #include "avs/report/run_data.hpp"
 #include "avs/report/summary.hpp"
+#include "avs_program.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using avs::testing::json_number;
+using avs::testing::read_file;
 
 /// Distinct colours in a PNG (a blank or single-colour figure has 1 or 2).
 int distinct_colours(const fs::path& file, int& width, int& height) {
@@ -47,25 +44,16 @@ int distinct_colours(const fs::path& file, int& width, int& height) {
   return static_cast<int>(colours.size());
 }
 
-/// The number after `"key": ` in summary.json (null -> NaN).
-double json_number(const std::string& json, const std::string& key) {
-  const std::regex re("\"" + key + "\":\\s*(null|[-0-9.eE+]+)");
-  std::smatch m;
-  if (!std::regex_search(json, m, re)) throw std::runtime_error("no key " + key);
-  return m[1] == "null" ? std::nan("") : std::stod(m[1]);
-}
-
 TEST(Demo, ShortRunMakesAReportFromItsOwnData) {
   const fs::path dir = fs::temp_directory_path() / ("avs-demo-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const double seconds = 0.6;
   const std::string log = (dir.string() + ".log");
-  const std::string command = "AVS_DOMAIN_ID=190 " + std::string(AVS_PROGRAM) + " demo --seconds " +
-                              std::to_string(seconds) + " --out " + dir.string() + " > " + log +
-                              " 2>&1";
-  const int status = std::system(command.c_str());
-  const std::string output = read_file(log);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+  const int status =
+      avs::testing::run_avs("demo --seconds " + std::to_string(seconds) + " --out " + dir.string(),
+                            190, log, log + ".err");
+  const std::string output = read_file(log) + read_file(log + ".err");
+  ASSERT_EQ(status, 0) << output;
 
   // The report folder: data, summary, page, figures.
   for (const char* f : {"frames.csv", "meta.csv", "summary.json", "index.html"}) {
@@ -103,6 +91,7 @@ TEST(Demo, ShortRunMakesAReportFromItsOwnData) {
   EXPECT_NE(output.find(rate.str()), std::string::npos) << output;
   fs::remove_all(dir);
   fs::remove(log);
+  fs::remove(log + ".err");
 }
 
 }  // namespace
