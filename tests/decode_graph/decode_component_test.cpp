@@ -256,7 +256,8 @@ class TestDepthRecorder final : public runtime::Component {
             .publishes = {},
             .subscribes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
                            runtime::port<msgs::sensor_msgs::PointCloud2>("points", "/depth/points"),
-                           runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing")}};
+                           runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing"),
+                           runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info")}};
   }
 
   explicit TestDepthRecorder(ComponentContext& ctx) : Component(ctx) {
@@ -270,6 +271,8 @@ class TestDepthRecorder final : public runtime::Component {
     ctx.subscribe<msgs::avs_msgs::StageTiming>(
         "timing",
         [this](runtime::SamplePtr<msgs::avs_msgs::StageTiming> m) { timing.push_back(m); });
+    ctx.subscribe<msgs::avs_msgs::DepthInfo>(
+        "info", [this](runtime::SamplePtr<msgs::avs_msgs::DepthInfo> m) { info.push_back(m); });
   }
 
   std::vector<DepthRecord> depth;
@@ -277,6 +280,7 @@ class TestDepthRecorder final : public runtime::Component {
   runtime::SamplePtr<msgs::sensor_msgs::Image> last_depth;
   std::vector<runtime::SamplePtr<msgs::sensor_msgs::PointCloud2>> points;
   std::vector<runtime::SamplePtr<msgs::avs_msgs::StageTiming>> timing;
+  std::vector<runtime::SamplePtr<msgs::avs_msgs::DepthInfo>> info;
 
  private:
   void on_depth(const runtime::SamplePtr<msgs::sensor_msgs::Image>& m) {
@@ -415,6 +419,20 @@ TEST(DecodeComponent, RollingDepthPerPairMatchesThePlane) {
     EXPECT_EQ(runtime::from_ros_time(timing[p]->header.stamp).ns, depth[p].stamp_ns);
     EXPECT_EQ(runtime::get_string(timing[p]->stage), "decode");
     EXPECT_GT(timing[p]->processing_ms, 0.0);
+  }
+  // /depth/info: the data age of every depth image once the window is full, same stamp, the
+  // frame period measured from the stamps (1 ms), the age within the 2n-frame window.
+  const auto& info = run.recorder->info;
+  ASSERT_GE(info.size() + static_cast<std::size_t>(kBits), depth.size());
+  ASSERT_LE(info.size(), depth.size());
+  const std::size_t first = depth.size() - info.size();
+  for (std::size_t i = 0; i < info.size(); ++i) {
+    EXPECT_EQ(runtime::from_ros_time(info[i]->header.stamp).ns, depth[first + i].stamp_ns);
+    EXPECT_NEAR(info[i]->frame_period_s, 1e-3, 1e-9);
+    EXPECT_NEAR(info[i]->data_age_s,
+                (2.0 * info[i]->effective_age_pairs + 0.5) * info[i]->frame_period_s, 1e-12);
+    EXPECT_GT(info[i]->data_age_s, 0.0);
+    EXPECT_LT(info[i]->data_age_s, 2 * kBits * 1e-3);
   }
   // Points: organised XYZ, z equal to the depth image.
   ASSERT_FALSE(run.recorder->points.empty());

@@ -9,7 +9,8 @@
 // AVS_MATCHING_NOCV=1, AVS_MATCHING_INLIER=<ratio>, AVS_MATCHING_RMSE=<m> override the setup;
 // AVS_MATCHING_SUBCODE=<h> sets the decoder's subcode_half_window, AVS_MATCHING_DEPTH=truth
 // matches the renderer's ground-truth depth instead of the decoded one, AVS_MATCHING_STATIC=1
-// keeps the object at its start pose.
+// keeps the object at its start pose, AVS_MATCHING_NOAGE=1 extrapolates by the fixed lag instead
+// of the decoder's data age, AVS_MATCHING_DENSE=1 runs the per-frame ICP on the dense samples.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -71,7 +72,8 @@ Run run(const Setup& setup) {
                                                .toRotationMatrix() *
                                            motion.T_world_object_start.linear();
   }
-  const bool decoder_age = setup.decoder_age || std::getenv("AVS_MATCHING_AGE") != nullptr;
+  const bool decoder_age = (setup.decoder_age || std::getenv("AVS_MATCHING_AGE") != nullptr) &&
+                           std::getenv("AVS_MATCHING_NOAGE") == nullptr;
   if (setup.static_object || std::getenv("AVS_MATCHING_STATIC") != nullptr) {
     target.trajectory = std::make_shared<sim::StaticTrajectory>(motion.T_world_object_start);
   } else {
@@ -127,6 +129,8 @@ Run run(const Setup& setup) {
     config.tracker.max_rmse_m = static_cast<float>(std::atof(r));
   if (std::getenv("AVS_MATCHING_P2P")) config.tracker.icp.metric = IcpMetric::point_to_point;
   if (std::getenv("AVS_MATCHING_NOCV")) config.tracker.constant_velocity = false;
+  if (const char* d = std::getenv("AVS_MATCHING_DENSE"))
+    config.tracker.dense_icp_model = std::atoi(d) != 0;
   MatchingPipeline pipeline(make_model_cloud(object.mesh, model_config), config);
 
   const Eigen::Vector3d start = motion.T_world_object_start.translation();

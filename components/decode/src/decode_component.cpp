@@ -2,8 +2,9 @@
 // (/camera/pattern, mono8 + bit index, polarity, cycle) go into one RollingDecoder, placed by
 // their bit index and cycle counter (never by arrival); every completed positive/negative pair
 // gives a depth map (Eqs. 2-4, 500 Hz from 1000 fps) on /depth/image (32FC1, metres, NaN
-// invalid, stamp of the newest frame used), optionally a PointCloud2 on /depth/points, and the
-// wall-clock processing time of the pair on /timing. Dropped and out-of-order frames are counted
+// invalid, stamp of the newest frame used), optionally a PointCloud2 on /depth/points, the
+// map's data age on /depth/info (same stamp) and the wall-clock processing time of the pair on
+// /timing. Dropped and out-of-order frames are counted
 // by the decoder and reported on /diagnostics.
 #include <chrono>
 #include <cmath>
@@ -111,7 +112,8 @@ class DecodeComponent final : public runtime::Component {
                       runtime::port<msgs::sensor_msgs::PointCloud2>("points", "/depth/points",
                                                                     points_qos),
                       runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing",
-                                                                 keep_last_100)},
+                                                                 keep_last_100),
+                      runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info", keep_last_4)},
         .subscribes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
                                                                    keep_last_4)}};
   }
@@ -121,6 +123,7 @@ class DecodeComponent final : public runtime::Component {
         depth_(ctx.publisher<msgs::sensor_msgs::Image>("depth")),
         points_(ctx.publisher<msgs::sensor_msgs::PointCloud2>("points")),
         timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
+        info_(ctx.publisher<msgs::avs_msgs::DepthInfo>("info")),
         full_cycle_(ctx.param<std::string>("mode") == "full_cycle"),
         publish_points_(ctx.param<bool>("publish_points")),
         frame_id_(ctx.param<std::string>("frame_id")),
@@ -231,6 +234,18 @@ class DecodeComponent final : public runtime::Component {
     frame.polarity = m.positive ? Polarity::kPositive : Polarity::kNegative;
     frame.cycle = m.cycle;
 
+    // Frame period for the data age: a negative and the positive just before it (same bit,
+    // same cycle) are one frame apart.
+    const double stamp_s = runtime::from_ros_time(m.header.stamp).seconds();
+    if (!m.positive && previous_positive_ && previous_cycle_ == m.cycle &&
+        previous_bit_ == m.bit_index && stamp_s > previous_stamp_s_) {
+      frame_period_s_ = stamp_s - previous_stamp_s_;
+    }
+    previous_positive_ = m.positive;
+    previous_cycle_ = m.cycle;
+    previous_bit_ = m.bit_index;
+    previous_stamp_s_ = stamp_s;
+
     const DecoderStats before = decoder_.stats();
     // A negative may complete a pair: decode straight into the outgoing message (no copy).
     const bool publishable =
@@ -262,6 +277,18 @@ class DecodeComponent final : public runtime::Component {
     image->step = static_cast<std::uint32_t>(4 * width_);
     image->is_bigendian = 0;
     if (publish_points_) publish_points(*image);
+    // The data age before the image it describes (subscribers match them by stamp). A pair's
+    // information is effective_age_pairs pairs (2 frames each) plus half a frame (the pair's
+    // mid-time) older than the newest frame (docs/decode.md).
+    if (std::isfinite(result.effective_age_pairs) && frame_period_s_ > 0.0) {
+      auto info = runtime::make_sample<msgs::avs_msgs::DepthInfo>();
+      info->header.stamp = m.header.stamp;
+      runtime::set_string(info->header.frame_id, frame_id_);
+      info->effective_age_pairs = result.effective_age_pairs;
+      info->frame_period_s = frame_period_s_;
+      info->data_age_s = (2.0 * result.effective_age_pairs + 0.5) * frame_period_s_;
+      info_.publish(std::move(info));
+    }
     depth_.publish(std::move(image));
 
     const double ms = pending_ms_ + ms_since(start);
@@ -336,7 +363,13 @@ class DecodeComponent final : public runtime::Component {
   runtime::Publisher<msgs::sensor_msgs::Image> depth_;
   runtime::Publisher<msgs::sensor_msgs::PointCloud2> points_;
   runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
+  runtime::Publisher<msgs::avs_msgs::DepthInfo> info_;
   bool full_cycle_;
+  double frame_period_s_ = 0.0;
+  double previous_stamp_s_ = 0.0;
+  bool previous_positive_ = false;
+  std::uint32_t previous_cycle_ = 0;
+  std::uint8_t previous_bit_ = 0;
   bool publish_points_;
   std::string frame_id_;
   RollingDecoder decoder_;

@@ -3,12 +3,14 @@
 // mask by the depth window, S-PCD (Eq. 27, voxels, outliers), Tracker (LRF initial alignment,
 // ICP of Eqs. 21-26, loss and re-initialisation) -> /object/pose (camera frame),
 // /object/pose_world (through the head's joint angles interpolated at the image's stamp),
+// lag-compensated by the data age of /depth/info when it arrives with the image's stamp,
 // /object/match, /timing and, optionally, /object/scene_points.
 #include <cmath>
 #include <cstring>
 #include <deque>
 #include <fstream>
 #include <optional>
+#include <utility>
 
 #include "avs/geometry/head_kinematics.hpp"
 #include "avs/matching/pipeline.hpp"
@@ -120,6 +122,13 @@ class MatchingComponent final : public runtime::Component {
                              "drop S-PCD points whose mean neighbour distance is larger"),
              ParamSpec::real_list("icp_iterations", {0, 0, 1}, "",
                                   "[n1, n2, n3] per frame on 1/4, 1/2, all scene points"),
+             ParamSpec::string("icp_model", "mpcd",
+                               "per-frame ICP model: mpcd = the M-PCD (model_points), dense = "
+                               "the 4000 dense surface samples with mesh normals (less bias)",
+                               {"mpcd", "dense"}),
+             ParamSpec::real("icp_max_distance_m", 0.03, 1e-4, 1.0, "m",
+                             "per-frame ICP: scene points farther than this from their closest "
+                             "model point are not used"),
              ParamSpec::string("icp_metric", "auto",
                                "per-frame ICP metric; auto = point_to_point for the cylinder "
                                "(point-to-plane slides along its axis), else point_to_plane",
@@ -139,6 +148,11 @@ class MatchingComponent final : public runtime::Component {
                              "(docs/matching.md: measured lag and why the default)"),
              ParamSpec::real("velocity_window_s", d.velocity_window_s, 1e-4, 1.0, "s",
                              "span of tracked poses the velocity is estimated over"),
+             ParamSpec::boolean("use_depth_info", true,
+                                "with lag_compensation_s > 0: extrapolate by the data age of "
+                                "/depth/info (same stamp as the image) instead of the fixed "
+                                "lag_compensation_s, and keep the velocity history at the "
+                                "data's time"),
              ParamSpec::real("depth_min_m", 0.3, 0.0, 100.0, "m", "target mask: nearest depth"),
              ParamSpec::real("depth_max_m", 1.5, 0.0, 100.0, "m", "target mask: farthest depth"),
              ParamSpec::real("fx_px", 628.8, 1.0, 1e5, "px", "focal length along x"),
@@ -169,7 +183,8 @@ class MatchingComponent final : public runtime::Component {
                           "scene_points", "/object/scene_points", best_effort_2)},
         .subscribes = {
             runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
-            runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states")}};
+            runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states"),
+            runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info", keep_last_4)}};
   }
 
   explicit MatchingComponent(ComponentContext& ctx)
@@ -181,7 +196,8 @@ class MatchingComponent final : public runtime::Component {
         scene_points_(ctx.publisher<msgs::sensor_msgs::PointCloud2>("scene_points")),
         publish_scene_points_(ctx.param<bool>("publish_scene_points")),
         report_dir_(ctx.param<std::string>("report_dir")),
-        max_extrapolation_s_(ctx.param<double>("joint_max_extrapolation_s")) {
+        max_extrapolation_s_(ctx.param<double>("joint_max_extrapolation_s")),
+        use_depth_info_(ctx.param<bool>("use_depth_info")) {
     const ObjectModel object =
         load_object_model(ctx.param<std::string>("model"), ctx.param<std::string>("models_dir"));
     ModelCloudConfig model_config;
@@ -217,6 +233,9 @@ class MatchingComponent final : public runtime::Component {
     config.tracker.icp.metric = metric == "auto"             ? object.metric
                                 : metric == "point_to_point" ? IcpMetric::point_to_point
                                                              : IcpMetric::point_to_plane;
+    config.tracker.icp.max_correspondence_distance_m =
+        static_cast<float>(ctx.param<double>("icp_max_distance_m"));
+    config.tracker.dense_icp_model = ctx.param<std::string>("icp_model") == "dense";
     config.tracker.max_rmse_m = static_cast<float>(ctx.param<double>("max_rmse_m"));
     config.tracker.min_inlier_ratio = static_cast<float>(ctx.param<double>("min_inlier_ratio"));
     config.tracker.failures_before_loss =
@@ -247,14 +266,16 @@ class MatchingComponent final : public runtime::Component {
     ctx.subscribe<msgs::sensor_msgs::JointState>(
         "joint_states",
         [this](runtime::SamplePtr<msgs::sensor_msgs::JointState> m) { on_joints(*m); });
+    ctx.subscribe<msgs::avs_msgs::DepthInfo>(
+        "depth_info", [this](runtime::SamplePtr<msgs::avs_msgs::DepthInfo> m) { on_info(*m); });
     ctx.subscribe<msgs::sensor_msgs::Image>(
         "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
   }
 
   void on_deactivate() override {
-    log().info(images_, " depth images, ", poses_, " poses, ", world_poses_, " world poses, ",
-               initialisations_, " initial alignments, state ",
-               to_string(pipeline_->tracker().state()));
+    log().info(images_, " depth images (", aged_images_, " with their /depth/info age), ", poses_,
+               " poses, ", world_poses_, " world poses, ", initialisations_,
+               " initial alignments, state ", to_string(pipeline_->tracker().state()));
     if (report_dir_.empty()) return;
     const std::string file = report_dir_ + "/" + context().name() + ".csv";
     std::ofstream out(file);
@@ -284,6 +305,20 @@ class MatchingComponent final : public runtime::Component {
     joints_.add({runtime::from_ros_time(m.header.stamp).seconds(), *q[0], *q[1]});
   }
 
+  void on_info(const msgs::avs_msgs::DepthInfo& m) {
+    if (!use_depth_info_ || !std::isfinite(m.data_age_s) || m.data_age_s < 0.0) return;
+    ages_.push_back({runtime::from_ros_time(m.header.stamp).seconds(), m.data_age_s});
+    while (ages_.size() > 16) ages_.pop_front();
+  }
+
+  /// The data age /depth/info gave for this stamp, if it came.
+  std::optional<double> age_at(double stamp_s) const {
+    for (auto it = ages_.rbegin(); it != ages_.rend(); ++it) {
+      if (it->first == stamp_s) return it->second;
+    }
+    return std::nullopt;
+  }
+
   void on_depth(const msgs::sensor_msgs::Image& image) {
     const std::string_view encoding = runtime::get_string(image.encoding);
     if (encoding != "32FC1" || image.is_bigendian != 0 || image.step % 4 != 0 ||
@@ -302,7 +337,10 @@ class MatchingComponent final : public runtime::Component {
     const DepthView depth{reinterpret_cast<const float*>(image.data._buffer),
                           static_cast<int>(image.width), static_cast<int>(image.height),
                           static_cast<int>(image.step / 4)};
-    const PipelineOutput out = pipeline_->process(depth, stamp_s);
+    const std::optional<double> age = age_at(stamp_s);
+    if (age) ++aged_images_;
+    const PipelineOutput out =
+        age ? pipeline_->process(depth, stamp_s, *age) : pipeline_->process(depth, stamp_s);
     if (out.track.initialised_this_frame) ++initialisations_;
 
     std::optional<Eigen::Isometry3d> T_world_model;
@@ -432,10 +470,12 @@ class MatchingComponent final : public runtime::Component {
   bool publish_scene_points_;
   std::string report_dir_;
   double max_extrapolation_s_;
+  bool use_depth_info_;
+  std::deque<std::pair<double, double>> ages_;  // (stamp, data age) from /depth/info
   bool warned_encoding_ = false;
   bool warned_no_joints_ = false;
   bool warned_joint_names_ = false;
-  std::uint64_t images_ = 0, poses_ = 0, world_poses_ = 0, initialisations_ = 0;
+  std::uint64_t images_ = 0, aged_images_ = 0, poses_ = 0, world_poses_ = 0, initialisations_ = 0;
   std::string csv_;
 };
 

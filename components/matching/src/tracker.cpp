@@ -1,6 +1,8 @@
 #include "avs/matching/tracker.hpp"
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace avs::matching {
 
@@ -16,11 +18,40 @@ const char* to_string(TrackingState state) {
   return "unknown";
 }
 
+namespace {
+
+IcpConfig icp_config(const ModelCloud& model, const TrackerConfig& config) {
+  IcpConfig icp = config.icp;
+  // Dense samples are ~2 mm apart: keep the inlier test at the M-PCD's spacing.
+  if (config.dense_icp_model && !(icp.inlier_distance_m > 0.0F) && model.mean_spacing_m > 0.0F)
+    icp.inlier_distance_m = model.mean_spacing_m;
+  return icp;
+}
+
+bool use_dense(const ModelCloud& model, const TrackerConfig& config) {
+  return config.dense_icp_model && model.dense_points_m.size() >= 3 &&
+         model.dense_normals.size() == model.dense_points_m.size();
+}
+
+}  // namespace
+
 Tracker::Tracker(const ModelCloud& model, TrackerConfig config)
     : config_(config),
-      icp_(model.points_m, config.icp, model.normals),
+      icp_(use_dense(model, config) ? model.dense_points_m : model.points_m,
+           icp_config(model, config),
+           use_dense(model, config) ? model.dense_normals : model.normals),
       initial_(model, config.initial) {
-  if (!(config_.max_rmse_m > 0.0F)) config_.max_rmse_m = icp_.model_spacing_m();
+  if (config_.dense_icp_model && !use_dense(model, config)) {
+    throw std::invalid_argument(
+        "Tracker: dense_icp_model needs ModelCloud::dense_points_m with normals (got " +
+        std::to_string(model.dense_points_m.size()) + " points, " +
+        std::to_string(model.dense_normals.size()) + " normals)");
+  }
+  if (!(config_.max_rmse_m > 0.0F)) {
+    config_.max_rmse_m = config_.dense_icp_model && model.mean_spacing_m > 0.0F
+                             ? model.mean_spacing_m
+                             : icp_.model_spacing_m();
+  }
 }
 
 void Tracker::reset() {

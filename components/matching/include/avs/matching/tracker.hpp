@@ -16,6 +16,12 @@ struct TrackerConfig {
   /// Per-frame ICP: [0, 0, 1] as in the paper, point-to-plane (point-to-point on a few hundred
   /// model points keeps about a degree of bias, see docs/matching.md).
   IcpConfig icp = {.iterations = {0, 0, 1}, .metric = IcpMetric::point_to_plane};
+  /// Per-frame ICP against the dense surface samples (ModelCloud::dense_points_m, exact mesh
+  /// normals) instead of the M-PCD: the closest sample is then close to the closest surface
+  /// point, which removes most of the sparse model's bias (docs/matching.md). The initial
+  /// alignment still uses the M-PCD. Inlier distance and max_rmse_m default to the M-PCD's
+  /// spacing either way.
+  bool dense_icp_model = false;
   InitialAlignmentConfig initial;     ///< used on the first frame and after a loss
   bool constant_velocity = true;      ///< predict from the last two poses
   float max_rmse_m = 0.0F;            ///< above this the frame fails; 0 = model's mean spacing
