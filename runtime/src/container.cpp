@@ -65,15 +65,15 @@ struct Container::Impl {
   std::unique_ptr<dds::Topic> clock_topic;
   std::vector<TopicEntry*> read_topics;  // waitset attach token = index
   TopicEntry* clock_follow = nullptr;
+  Time last_diagnostics{};  ///< clock time of the previous /diagnostics report
 };
 
 namespace {
 
 TimeMode time_mode_for(const graph::Graph& g, const graph::ContainerSpec& s) {
   if (g.clock.source == graph::ClockSpec::Source::wall) return TimeMode::wall;
-  const std::string master = g.clock.master.empty() && !g.containers.empty()
-                                 ? g.containers.front().name
-                                 : g.clock.master;
+  const std::string master =
+      g.clock.master.empty() && !g.containers.empty() ? g.containers.front().name : g.clock.master;
   if (s.name != master) return TimeMode::sim_follower;
   return g.clock.mode == graph::ClockSpec::Mode::lockstep ? TimeMode::sim_lockstep
                                                           : TimeMode::sim_realtime;
@@ -175,8 +175,9 @@ class ComponentHost final : public ComponentContext {
       throw Error(what + " is declared as " + found->dds_type + " but used as " + type.dds_name);
     }
     const auto remap = instance_.remaps.find(found->name);
-    const std::string ros_name = resolve_topic_name(
-        container_.graph.ns, remap != instance_.remaps.end() ? remap->second : found->default_topic);
+    const std::string ros_name =
+        resolve_topic_name(container_.graph.ns,
+                           remap != instance_.remaps.end() ? remap->second : found->default_topic);
     const auto qos = instance_.qos.find(found->name);
     return {to_dds_topic_name(ros_name), qos != instance_.qos.end() ? qos->second : found->qos};
   }
@@ -220,7 +221,8 @@ std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view po
   if (container_.running) throw Error("publishers must be created in the constructor");
   auto [dds_name, qos] = resolve(port, type, true);
   TopicEntry& topic = container_.topic(dds_name, type, qos);
-  if (!topic.writer) topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
+  if (!topic.writer)
+    topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
   return std::make_shared<LocalPublisher>(*container_.scheduler, topic);
 }
 
@@ -229,7 +231,8 @@ void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntr
   if (container_.running) throw Error("subscriptions must be created in the constructor");
   auto [dds_name, qos] = resolve(port, type, false);
   TopicEntry& topic = container_.topic(dds_name, type, qos);
-  if (!topic.reader) topic.reader = std::make_unique<dds::Reader>(container_.participant, *topic.topic, qos);
+  if (!topic.reader)
+    topic.reader = std::make_unique<dds::Reader>(container_.participant, *topic.topic, qos);
   topic.subscriptions.push_back(
       {lane_, [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
          guard([&] { cb(std::move(sample)); })();
@@ -237,7 +240,10 @@ void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntr
 }
 
 Container::Impl::Impl(const graph::Graph& g, const graph::ContainerSpec& s)
-    : graph(g), spec(s), log("container/" + s.name), participant(dds::effective_domain(g.domain_id)) {
+    : graph(g),
+      spec(s),
+      log("container/" + s.name),
+      participant(dds::effective_domain(g.domain_id)) {
   scheduler = std::make_unique<Scheduler>(time_mode_for(g, s), g.clock.real_time_factor);
 }
 
@@ -265,7 +271,10 @@ void Container::Impl::fail(const std::string& what) {
 void Container::Impl::publish_diagnostics(dds::Writer& writer) {
   if (writer.matched_readers() == 0) return;
   auto array = make_sample<msgs::diagnostic_msgs::DiagnosticArray>();
-  to_ros_time(scheduler->now(), array->header.stamp);
+  const Time now = scheduler->now();
+  const double interval_s = (now - last_diagnostics).count() * 1e-9;
+  last_diagnostics = now;
+  to_ros_time(now, array->header.stamp);
   resize_sequence(array->status, static_cast<std::uint32_t>(hosts.size()));
   for (std::size_t i = 0; i < hosts.size(); ++i) {
     ComponentHost& host = *hosts[i];
@@ -275,10 +284,18 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
     set_string(status.name, spec.name + "/" + host.instance().name);
     set_string(status.message, failed ? "container failed" : "active");
     set_string(status.hardware_id, host.instance().type);
+    // rate_hz: callbacks (timers and samples) per second of the container's clock since the
+    // last report; callback_ms_*: wall-clock time spent in them (the component's latency).
+    const double mean_ms =
+        stats.callbacks ? stats.total_ms / static_cast<double>(stats.callbacks) : 0.0;
     const std::pair<const char*, std::string> values[] = {
+        {"state", failed ? "failed" : (running ? "active" : "inactive")},
         {"callbacks", std::to_string(stats.callbacks)},
-        {"callback_ms_mean", std::to_string(stats.callbacks ? stats.total_ms / static_cast<double>(stats.callbacks) : 0.0)},
+        {"rate_hz",
+         std::to_string(interval_s > 0 ? static_cast<double>(stats.callbacks) / interval_s : 0.0)},
+        {"callback_ms_mean", std::to_string(mean_ms)},
         {"callback_ms_max", std::to_string(stats.max_ms)}};
+    constexpr std::size_t kOwn = std::size(values);
     std::vector<std::pair<std::string, std::string>> extra;
     if (host.component) {
       try {
@@ -287,14 +304,14 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
         extra = {{"diagnostic_values_error", e.what()}};
       }
     }
-    resize_sequence(status.values, static_cast<std::uint32_t>(3 + extra.size()));
-    for (std::size_t k = 0; k < 3; ++k) {
+    resize_sequence(status.values, static_cast<std::uint32_t>(kOwn + extra.size()));
+    for (std::size_t k = 0; k < kOwn; ++k) {
       set_string(status.values._buffer[k].key, values[k].first);
       set_string(status.values._buffer[k].value, values[k].second);
     }
     for (std::size_t k = 0; k < extra.size(); ++k) {
-      set_string(status.values._buffer[3 + k].key, extra[k].first);
-      set_string(status.values._buffer[3 + k].value, extra[k].second);
+      set_string(status.values._buffer[kOwn + k].key, extra[k].first);
+      set_string(status.values._buffer[kOwn + k].value, extra[k].second);
     }
   }
   writer.write(array.get());
@@ -312,7 +329,8 @@ void Container::Impl::reader_loop() {
     }
     for (int i = 0; i < n; ++i) {
       if (triggered[static_cast<std::size_t>(i)] == 0) continue;  // the guard condition
-      TopicEntry& topic = *read_topics[static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)] - 1)];
+      TopicEntry& topic =
+          *read_topics[static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)] - 1)];
       for (;;) {
         std::shared_ptr<void> sample = allocate_sample(*topic.type);
         void* buffers[1] = {sample.get()};
@@ -337,9 +355,13 @@ Container::Container(const graph::Graph& graph, const graph::ContainerSpec& spec
 
 Container::~Container() = default;
 
-void Container::stop() { impl_->scheduler->stop(); }
+void Container::stop() {
+  impl_->scheduler->stop();
+}
 
-Time Container::now() const { return impl_->scheduler->now(); }
+Time Container::now() const {
+  return impl_->scheduler->now();
+}
 
 Component* Container::find_component(const std::string& name) const {
   for (const auto& host : impl_->hosts) {
@@ -363,11 +385,13 @@ int Container::run() {
       c.log.error("component '", instance.name, "': unknown type '", instance.type, "'");
       return 1;
     }
-    auto host = std::make_unique<ComponentHost>(c, instance, *registered, per_component ? index : 0);
+    auto host =
+        std::make_unique<ComponentHost>(c, instance, *registered, per_component ? index : 0);
     try {
       host->component = registered->factory(*host);
     } catch (const std::exception& e) {
-      c.log.error("component '", instance.name, "' (", instance.type, ") failed to load: ", e.what());
+      c.log.error("component '", instance.name, "' (", instance.type,
+                  ") failed to load: ", e.what());
       return 1;
     }
     c.hosts.push_back(std::move(host));
@@ -379,7 +403,8 @@ int Container::run() {
   const msg::TypeEntry* clock_type = msg::find_type("rosgraph_msgs::msg::dds_::Clock_");
   const QosProfile clock_qos = *QosProfile::named("clock");
   if (mode == TimeMode::sim_lockstep || mode == TimeMode::sim_realtime) {
-    c.clock_topic = std::make_unique<dds::Topic>(c.participant, clock_type->descriptor, "rt/clock", clock_qos);
+    c.clock_topic =
+        std::make_unique<dds::Topic>(c.participant, clock_type->descriptor, "rt/clock", clock_qos);
     c.clock_writer = std::make_unique<dds::Writer>(c.participant, *c.clock_topic, clock_qos);
     scheduler.on_time_advanced([&c](Time t) {
       rosgraph_msgs_msg_dds__Clock_ sample{};
@@ -388,16 +413,21 @@ int Container::run() {
     });
   } else if (mode == TimeMode::sim_follower) {
     TopicEntry& topic = c.topic("rt/clock", *clock_type, clock_qos);
-    if (!topic.reader) topic.reader = std::make_unique<dds::Reader>(c.participant, *topic.topic, clock_qos);
+    if (!topic.reader)
+      topic.reader = std::make_unique<dds::Reader>(c.participant, *topic.topic, clock_qos);
     c.clock_follow = &topic;
   }
 
   // Health: one DiagnosticStatus per component on /diagnostics, every second of the clock.
   {
-    const msg::TypeEntry* diag_type = msg::find_type("diagnostic_msgs::msg::dds_::DiagnosticArray_");
+    const msg::TypeEntry* diag_type =
+        msg::find_type("diagnostic_msgs::msg::dds_::DiagnosticArray_");
     TopicEntry& topic = c.topic("rt/diagnostics", *diag_type, QosProfile{});
-    if (!topic.writer) topic.writer = std::make_unique<dds::Writer>(c.participant, *topic.topic, QosProfile{});
-    scheduler.add_timer(0, std::chrono::seconds(1), [&c, &topic] { c.publish_diagnostics(*topic.writer); });
+    if (!topic.writer)
+      topic.writer = std::make_unique<dds::Writer>(c.participant, *topic.topic, QosProfile{});
+    c.last_diagnostics = scheduler.now();
+    scheduler.add_timer(0, std::chrono::seconds(1),
+                        [&c, &topic] { c.publish_diagnostics(*topic.writer); });
   }
 
   // DDS inputs from other processes.
@@ -405,8 +435,9 @@ int Container::run() {
   for (auto& [name, topic] : c.topics) {
     if (!topic->reader) continue;
     c.read_topics.push_back(topic.get());
-    topic->read_condition = dds::Entity(check_dds(
-        dds_create_readcondition(topic->reader->get(), DDS_ANY_STATE), "read condition on " + name));
+    topic->read_condition =
+        dds::Entity(check_dds(dds_create_readcondition(topic->reader->get(), DDS_ANY_STATE),
+                              "read condition on " + name));
     c.waitset->attach(topic->read_condition.get(), static_cast<dds_attach_t>(c.read_topics.size()));
   }
 
@@ -431,7 +462,8 @@ int Container::run() {
   {
     std::thread reader([&c] { c.reader_loop(); });
     std::vector<std::thread> lanes;
-    for (int i = 0; i < lane_count; ++i) lanes.emplace_back([&scheduler, i] { scheduler.run_lane(i); });
+    for (int i = 0; i < lane_count; ++i)
+      lanes.emplace_back([&scheduler, i] { scheduler.run_lane(i); });
     for (auto& t : lanes) t.join();
     scheduler.stop();
     c.waitset->wake();
