@@ -46,6 +46,7 @@ struct Child {
   int restarts = 0;
   double backoff_s = 0;
   double restart_at = -1;  // monotonic seconds; <0: none pending
+  double started_at = 0;   // monotonic seconds of the last (re)start
   bool done = false;
   int status = 0;
 };
@@ -106,11 +107,15 @@ std::string describe_status(int status) {
   return "stopped";
 }
 
+/// A container that ran this long before it ended gets a fresh restart budget and back-off.
+constexpr double kStableRunS = 60.0;
+
 /// Runs `children` until all ended (or Ctrl-C / SIGTERM); applies respawn policies.
 int supervise(std::vector<Child>& children, const sigset_t& handled, const sigset_t& original) {
   std::map<pid_t, Child*> by_pid;
   for (auto& child : children) {
     child.pid = spawn(child.plan, original);
+    child.started_at = monotonic_s();
     child.backoff_s = child.spec->respawn.backoff_s;
     by_pid[child.pid] = &child;
     std::cerr << "avs launch: started container '" << child.spec->name << "' (pid " << child.pid
@@ -159,6 +164,12 @@ int supervise(std::vector<Child>& children, const sigset_t& handled, const sigse
       const auto& policy = c.spec->respawn;
       const bool respawn =
           !stopping && (policy.kind == Kind::always || (policy.kind == Kind::on_failure && failed));
+      // A container that ran stably for a while failed anew, not again: fresh back-off and
+      // restart budget (otherwise a process that fails once a day would run out of restarts).
+      if (now - c.started_at >= kStableRunS) {
+        c.restarts = 0;
+        c.backoff_s = policy.backoff_s;
+      }
       if (respawn && c.restarts < policy.max_restarts) {
         c.restart_at = now + c.backoff_s;
         std::cerr << "avs launch: restarting '" << c.spec->name << "' in " << c.backoff_s
@@ -176,6 +187,7 @@ int supervise(std::vector<Child>& children, const sigset_t& handled, const sigse
         c.restart_at = -1;
         ++c.restarts;
         c.pid = spawn(c.plan, original);
+        c.started_at = now;
         by_pid[c.pid] = &c;
         std::cerr << "avs launch: restarted container '" << c.spec->name << "' (pid " << c.pid
                   << ")\n";
