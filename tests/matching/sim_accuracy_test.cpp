@@ -55,6 +55,9 @@ struct Setup {
   /// the data's time and extrapolates the published pose by that age (translation only).
   bool decoder_age = true;
   double velocity_window_s = 0.03;  ///< MatchingPipeline::velocity_window_s
+  /// launch_config/closed_loop.yaml's matching tuning: per-frame ICP on the dense samples,
+  /// 15 mm pairs, 500 scene points on a 5 mm voxel (else the component's defaults).
+  bool closed_loop_tuning = false;
 };
 
 Run run(const Setup& setup) {
@@ -108,6 +111,12 @@ Run run(const Setup& setup) {
                    lens.width,
                    lens.height};
   config.scene.target_points = object.scene_points;
+  if (setup.closed_loop_tuning) {
+    config.tracker.dense_icp_model = true;
+    config.tracker.icp.max_correspondence_distance_m = 0.015F;
+    config.scene.target_points = 500;
+    config.scene.voxel_size_m = 0.005F;
+  }
   config.lag_compensation_s = setup.lag_compensation_s;
   config.velocity_window_s = setup.velocity_window_s;
   // With the decoder's age the extrapolation horizon is that age; lag_compensation_s > 0 is the
@@ -149,7 +158,8 @@ Run run(const Setup& setup) {
       (setup.lag_compensation_s > 0 ? std::to_string(setup.lag_compensation_s * 1e3) + " ms" : "") +
       (setup.subcode_half_window > 0 ? ", sub-code h " + std::to_string(setup.subcode_half_window)
                                      : ", code centres") +
-      (setup.decoder_age ? ", age comp" : "");
+      (setup.decoder_age ? ", age comp" : "") +
+      (setup.closed_loop_tuning ? ", closed-loop tuning" : "");
   double total_ms = 0;
   const int frames = static_cast<int>(setup.end_s * sim_config.frame_rate_hz);
   const int window = 2 * decoder_config.geometry.layout.bit_count;
@@ -272,6 +282,13 @@ void check(const Setup& setup, double max_position_rms_mm, double max_rotation_r
 // Section 7.2.1: the ken on the manipulator (pi/2 about Z, pi/4 about Y, -pi/4 about Z in 2 s).
 TEST(SimAccuracy, KenOnTheManipulatorTrajectory) {
   check({.object = "ken", .follow = true}, 4.5, 3.5);
+}
+// The same with launch_config/closed_loop.yaml's matching tuning: the goals.
+TEST(SimAccuracy, KenWithTheClosedLoopTuning) {
+  check({.object = "ken", .follow = true, .closed_loop_tuning = true}, 3.0, 2.0);
+}
+TEST(SimAccuracy, CubeWithTheClosedLoopTuning) {
+  check({.object = "cube", .follow = true, .closed_loop_tuning = true}, 3.0, 2.0);
 }
 // Sections 7.2.2 and 7.2.3 give no motion: the same manipulator motion.
 TEST(SimAccuracy, CubeOnTheManipulatorTrajectory) {

@@ -63,15 +63,20 @@ class TestMatchingSource final : public runtime::Component {
     return {
         .type = "test_matching_source",
         .description = "tests: joint states at 1 kHz and depth images of the ken at 500 Hz",
-        .parameters = {},
+        .parameters = {ParamSpec::real("info_age_s", -1.0, -1.0, 1.0, "s",
+                                       "data age sent on /depth/info before each image "
+                                       "(negative: no /depth/info)")},
         .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
-                      runtime::port<msgs::sensor_msgs::JointState>("joints", "/head/joint_states")},
+                      runtime::port<msgs::sensor_msgs::JointState>("joints", "/head/joint_states"),
+                      runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info")},
         .subscribes = {}};
   }
   explicit TestMatchingSource(ComponentContext& ctx)
       : Component(ctx),
         depth_(ctx.publisher<msgs::sensor_msgs::Image>("depth")),
         joints_(ctx.publisher<msgs::sensor_msgs::JointState>("joints")),
+        info_(ctx.publisher<msgs::avs_msgs::DepthInfo>("info")),
+        info_age_s_(ctx.param<double>("info_age_s")),
         mesh_(load_object_model("ken").mesh) {}
   void on_activate() override {
     context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
@@ -113,6 +118,14 @@ class TestMatchingSource final : public runtime::Component {
       z[i] = image.depth_m[i] > 0 ? image.depth_m[i] : std::numeric_limits<float>::quiet_NaN();
     }
     depth_stamps_ns.push_back(now.ns);
+    if (info_age_s_ >= 0.0) {
+      auto info = runtime::make_sample<msgs::avs_msgs::DepthInfo>();
+      runtime::to_ros_time(now, info->header.stamp);
+      info->data_age_s = info_age_s_;
+      info->frame_period_s = 1e-3;
+      info->effective_age_pairs = (info_age_s_ / 1e-3 - 0.5) / 2.0;
+      info_.publish(std::move(info));
+    }
     depth_.publish(std::move(m));
   }
 
@@ -122,6 +135,8 @@ class TestMatchingSource final : public runtime::Component {
  private:
   runtime::Publisher<msgs::sensor_msgs::Image> depth_;
   runtime::Publisher<msgs::sensor_msgs::JointState> joints_;
+  runtime::Publisher<msgs::avs_msgs::DepthInfo> info_;
+  double info_age_s_;
   geometry::Mesh mesh_;
   std::uint64_t tick_ = 0;
 };
@@ -192,7 +207,8 @@ struct GraphRun {
   TestMatchingRecorder* recorder = nullptr;
 };
 
-GraphRun run_graph(int domain, double duration_s, const std::string& matching_params) {
+GraphRun run_graph(int domain, double duration_s, const std::string& matching_params,
+                   const std::string& source_params = "{}") {
   setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
   const auto dir =
       std::filesystem::temp_directory_path() /
@@ -207,7 +223,8 @@ GraphRun run_graph(int domain, double duration_s, const std::string& matching_pa
         << "  - name: matching\n"
         << "    executor: single_threaded\n"
         << "    components:\n"
-        << "      - {type: test_matching_source, name: source}\n"
+        << "      - {type: test_matching_source, name: source, parameters: " << source_params
+        << "}\n"
         << "      - {type: matching, name: matching, parameters: " << matching_params << "}\n"
         << "      - {type: test_matching_recorder, name: recorder}\n";
   }
@@ -244,8 +261,7 @@ TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
   for (std::size_t i = 0; i < depth.size(); ++i) {
     EXPECT_EQ(runtime::from_ros_time(rec.match[i]->header.stamp).ns, depth[i]);
   }
-  EXPECT_EQ(rec.match.front()->state,
-            avs_msgs_msg_dds__MatchResult_Constants_STATE_INITIALISING)
+  EXPECT_EQ(rec.match.front()->state, avs_msgs_msg_dds__MatchResult_Constants_STATE_INITIALISING)
       << "the first image runs the initial alignment";
   EXPECT_EQ(rec.match[1]->state, avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING)
       << "and tracking goes on from it";
@@ -295,6 +311,41 @@ TEST(MatchingComponent, WithoutJointStatesOnlyTheCameraPoseIsPublished) {
   EXPECT_EQ(run.recorder->camera.size(), run.source->depth_stamps_ns.size());
   EXPECT_TRUE(run.recorder->world.empty());
   EXPECT_TRUE(run.recorder->clouds.empty()) << "scene points are off by default";
+}
+
+// Lag compensation by /depth/info: the rendered images have no lag, so an age of 0 from
+// /depth/info must leave the pose as matched, while the fixed 50 ms (use_depth_info off) moves
+// it well ahead (the ken moves 0.2 m/s and the panning head adds up to 1.3 rad/s).
+double max_camera_error_mm(const GraphRun& run) {
+  const auto& depth = run.source->depth_stamps_ns;
+  double max_mm = 0;
+  EXPECT_EQ(run.recorder->camera.size(), depth.size());
+  for (std::size_t i = 0; i < std::min(depth.size(), run.recorder->camera.size()); ++i) {
+    const double t = static_cast<double>(depth[i]) * 1e-9;
+    const Eigen::Isometry3d truth_camera =
+        geometry::T_world_camera(head_config(), pan_at(t), kTilt).inverse() * T_world_ken(t);
+    max_mm = std::max(
+        max_mm,
+        1e3 * (run.recorder->camera[i].T.translation() - truth_camera.translation()).norm());
+  }
+  return max_mm;
+}
+
+TEST(MatchingComponent, LagCompensationUsesTheDataAgeOfDepthInfo) {
+  GraphRun with_info =
+      run_graph(153, 0.2, "{model: ken, lag_compensation_s: 0.05}", "{info_age_s: 0.0}");
+  ASSERT_NE(with_info.recorder, nullptr);
+  GraphRun fixed =
+      run_graph(154, 0.2, "{model: ken, lag_compensation_s: 0.05, use_depth_info: false}",
+                "{info_age_s: 0.0}");
+  ASSERT_NE(fixed.recorder, nullptr);
+  const double with_info_mm = max_camera_error_mm(with_info);
+  const double fixed_mm = max_camera_error_mm(fixed);
+  std::printf(
+      "camera position max error: data age 0 from /depth/info %.2f mm, fixed 50 ms %.2f mm\n",
+      with_info_mm, fixed_mm);
+  EXPECT_LT(with_info_mm, 4.0);
+  EXPECT_GT(fixed_mm, 6.0);
 }
 
 TEST(MatchingComponent, UnknownModelFailsTheContainerLoudly) {
