@@ -55,8 +55,9 @@ struct Setup {
   /// the data's time and extrapolates the published pose by that age (translation only).
   bool decoder_age = true;
   double velocity_window_s = 0.03;  ///< MatchingPipeline::velocity_window_s
-  /// launch_config/closed_loop.yaml's matching tuning: per-frame ICP on the dense samples,
-  /// 15 mm pairs, 500 scene points on a 5 mm voxel (else the component's defaults).
+  /// launch_config/closed_loop.yaml's matching tuning: per-frame [0,0,2] ICP on the dense
+  /// samples, 15 mm pairs, 500 scene points on a 5 mm voxel, 8 outlier-test neighbours (else
+  /// the component's defaults).
   bool closed_loop_tuning = false;
 };
 
@@ -116,6 +117,8 @@ Run run(const Setup& setup) {
     config.tracker.icp.max_correspondence_distance_m = 0.015F;
     config.scene.target_points = 500;
     config.scene.voxel_size_m = 0.005F;
+    config.scene.outlier_neighbours = 8;
+    config.tracker.icp.iterations = {0, 0, 2};
   }
   config.lag_compensation_s = setup.lag_compensation_s;
   config.velocity_window_s = setup.velocity_window_s;
