@@ -47,10 +47,10 @@ const std::vector<PaperFigure>& paper_figures() {
        "'The frequency of the ICP was 487 fps'"},
       {"cylinder", "pose_rate_hz", "ICP rate", "495", "Hz", "7.2.3",
        "'The frequency of the ICP was 495 fps'"},
+      // The cube's 93.98 ms (7.2.2) is compared in the "cube" scenario, which aligns the cube;
+      // the "init" scenario aligns the ken only.
       {"init", "init_ms", "initial alignment (ken)", "148", "ms", "7.2.1, 7.4",
        "'The time required for the initial alignment was 148 ms'"},
-      {"init", "init_ms", "initial alignment (cube)", "93.98", "ms", "7.2.2, 7.4",
-       "'The time required for the initial alignment was 93.98 ms'"},
       {"correction", "depth_rate_hz", "depth update rate", "500", "Hz", "7.3",
        "Fig. 21: correction shown as pictures only"},
   };
