@@ -147,6 +147,16 @@ InitialAligner::InitialAligner(const ModelCloud& model, InitialAlignmentConfig c
   const PointFeatures features =
       compute_features(model.points_m, model_tree_, config_.model_features, outward);
   model_lrfs_ = compute_lrfs(model.points_m, features, config_.model_features);
+  // Flat faces for the plane hypotheses (our addition): the mesh's outward normals where the
+  // voxel has one, else the oriented Eq. 18 normals.
+  Points face_normals = features.normals;
+  for (std::size_t i = 0; i < face_normals.size() && i < model.normals.size(); ++i) {
+    if (!model.normals[i].isZero()) face_normals[i] = model.normals[i].normalized();
+  }
+  if (config_.plane_rotations > 0) {
+    model_faces_ =
+        find_planar_patches(model.points_m, face_normals, config_.model_faces, spacing_m_);
+  }
 }
 
 float InitialAligner::score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
@@ -174,14 +184,21 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   InitialAlignmentResult result;
   scene_lrfs_.clear();
   scene_lrfs_used_.clear();
-  if (p_camera.size() < 10 || model_lrfs_.empty()) return result;
+  if (p_camera.size() < 10 || (model_lrfs_.empty() && model_faces_.empty())) return result;
 
   auto start = Clock::now();
   // 1. Scene features and LRFs (normals toward the camera at the origin).
   const KdTree scene_tree(p_camera);
   const PointFeatures features = compute_features(p_camera, scene_tree, config_.scene_features, {});
   scene_lrfs_ = compute_lrfs(p_camera, features, config_.scene_features);
-  if (scene_lrfs_.empty()) return result;
+  // Large planar scene patches (normals toward the camera) for the plane hypotheses.
+  std::vector<PlanarPatch> scene_planes;
+  if (config_.plane_rotations > 0 && !model_faces_.empty()) {
+    scene_planes =
+        find_planar_patches(p_camera, features.normals, config_.scene_planes, spacing_m_);
+  }
+  result.scene_planes = scene_planes.size();
+  if (scene_lrfs_.empty() && scene_planes.empty()) return result;
 
   // 2. Down-sample the scene LRFs (rate 0.1 in the paper), seeded and without repetition.
   std::vector<std::size_t> order(scene_lrfs_.size());
@@ -206,26 +223,55 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   // Random order: a partial sum then already samples the whole object, so a wrong hypothesis
   // is abandoned after a few points.
   std::shuffle(subset.begin(), subset.end(), rng);
-  std::vector<Hypothesis> best;  // sorted ascending by score, at most refine_candidates * 4
+  // Scores a hypothesis into `list` (sorted ascending, at most `keep`), abandoning it once it
+  // costs more than the list's worst.
+  const auto offer = [&](std::vector<Hypothesis>& list, std::size_t keep,
+                         const Eigen::Isometry3f& T_model_camera) {
+    const float limit =
+        list.size() < keep ? std::numeric_limits<float>::infinity() : list.back().score;
+    const float s = score(p_camera, subset, T_model_camera, limit);
+    if (!(s < limit)) return;
+    const auto at =
+        std::lower_bound(list.begin(), list.end(), s,
+                         [](const Hypothesis& h, float value) { return h.score < value; });
+    list.insert(at, {T_model_camera, s});
+    if (list.size() > keep) list.pop_back();
+  };
+  std::vector<Hypothesis> best;  // at most refine_candidates * 4
   const std::size_t keep = std::max<std::size_t>(1, config_.refine_candidates) * 4;
   for (const auto& scene : scene_lrfs_used_) {
     for (const auto& model : model_lrfs_) {
-      const Eigen::Isometry3f T_model_camera = lrf_transform(scene, model);
-      const float limit =
-          best.size() < keep ? std::numeric_limits<float>::infinity() : best.back().score;
-      const float s = score(p_camera, subset, T_model_camera, limit);
+      offer(best, keep, lrf_transform(scene, model));
       ++result.hypotheses;
-      if (!(s < limit)) continue;
-      const auto at =
-          std::lower_bound(best.begin(), best.end(), s,
-                           [](const Hypothesis& h, float value) { return h.score < value; });
-      best.insert(at, {T_model_camera, s});
-      if (best.size() > keep) best.pop_back();
+    }
+  }
+  // 3b. Plane hypotheses (our addition beyond the paper's Eq. 20 LRF pairs): each planar scene
+  //     patch against each flat model face, the face's outward normal turned onto the patch's
+  //     normal (which faces the camera) and the centroids matched, at plane_rotations turns about
+  //     the normal (the in-plane angle is free); scored like the LRF pairs, kept apart so a flat
+  //     scene's right pose is refined and verified even when LRF pairs score better on the
+  //     subset.
+  std::vector<Hypothesis> plane_best;  // at most plane_candidates * 4
+  const std::size_t plane_keep = std::max<std::size_t>(1, config_.plane_candidates) * 4;
+  const float turn = 2.0F * std::numbers::pi_v<float> /
+                     static_cast<float>(std::max<std::size_t>(1, config_.plane_rotations));
+  for (const auto& scene : scene_planes) {
+    for (const auto& face : model_faces_) {
+      const Eigen::Matrix3f onto =
+          Eigen::Quaternionf::FromTwoVectors(face.normal, scene.normal).toRotationMatrix();
+      for (std::size_t r = 0; r < config_.plane_rotations; ++r) {
+        Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
+        T_camera_model.linear() =
+            Eigen::AngleAxisf(turn * static_cast<float>(r), scene.normal).toRotationMatrix() * onto;
+        T_camera_model.translation() = scene.centroid_m - T_camera_model.linear() * face.centroid_m;
+        offer(plane_best, plane_keep, T_camera_model.inverse());
+        ++result.plane_hypotheses;
+      }
     }
   }
   result.scene_lrfs = scene_lrfs_used_.size();
   result.model_lrfs = model_lrfs_.size();
-  if (best.empty()) return result;
+  if (best.empty() && plane_best.empty()) return result;
 
   result.scoring_ms = ms_since(start);
   start = Clock::now();
@@ -244,6 +290,16 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
   for (std::size_t c = 0; c < std::min(config_.flip_candidates, unflipped); ++c) {
     // T_model_camera of a flipped pose: flip^-1 applied in the model frame.
     for (const auto& flip : flips_model_) distinct.push_back(flip.inverse() * distinct[c]);
+  }
+  // The best distinct plane hypotheses join them (our addition, see 3b).
+  std::size_t planes_added = 0;
+  for (const auto& h : plane_best) {
+    if (planes_added >= config_.plane_candidates) break;
+    if (std::none_of(distinct.begin(), distinct.end(),
+                     [&](const auto& d) { return similar(d, h.T_model_camera); })) {
+      distinct.push_back(h.T_model_camera);
+      ++planes_added;
+    }
   }
   // 4a. Refine every candidate by ICP on the M-PCD and screen it by the mean truncated distance
   //     from the scene to the dense model surface (tabulated).

@@ -53,6 +53,35 @@ struct Lrf {
 [[nodiscard]] std::vector<Lrf> compute_lrfs(const Points& points, const PointFeatures& features,
                                             const FeatureConfig& config);
 
+/// A planar region of a cloud (plane normal, centroid of its points). Our addition beyond the
+/// paper: section 6.1 proposes poses only from LRFs at curved feature points (Eq. 19), so a scene
+/// that shows a single flat face (the cylinder end-on: a disc) gets no right hypothesis, and a
+/// model's flat faces get no LRF at all. InitialAligner pairs scene patches with model faces.
+struct PlanarPatch {
+  Eigen::Vector3f normal = Eigen::Vector3f::UnitZ();  ///< unit, oriented like the input normals
+  Eigen::Vector3f centroid_m = Eigen::Vector3f::Zero();
+  std::size_t points = 0;
+};
+
+struct PlaneConfig {
+  float normal_tolerance_rad = 0.17F;  ///< member normals within this angle of the plane's
+  float offset_tolerance = 0.5F;       ///< member distance to the plane, times the spacing
+  float min_extent = 1.0F;             ///< smaller in-plane standard deviation, times the spacing
+  float min_fraction = 0.2F;           ///< a patch holds at least this fraction of the points ...
+  std::size_t min_points = 12;         ///< ... and at least this many
+  std::size_t max_patches = 3;         ///< largest patches kept
+  std::size_t max_seeds = 64;          ///< seed points tried per patch (evenly spread)
+};
+
+/// Planar patches found greedily (largest first) from oriented normals (zero normals are
+/// skipped): members share the seed's normal within the tolerance and lie near its plane; the
+/// plane is then refitted (covariance, Eq. 18) and a patch too thin in-plane (a strip of a
+/// curved surface) is dropped.
+[[nodiscard]] std::vector<PlanarPatch> find_planar_patches(const Points& points,
+                                                           const Points& normals,
+                                                           const PlaneConfig& config,
+                                                           float spacing_m);
+
 /// Unoriented normals from the k nearest neighbours' covariance (for point-to-plane ICP).
 [[nodiscard]] Points estimate_normals(const Points& points, std::size_t neighbours);
 

@@ -2,7 +2,8 @@
 // verification: the best LRF-pair hypotheses (and their end-for-end turns) are refined by ICP
 // and re-scored on the whole S-PCD against the dense model surface, with a free-space term (model
 // surface the pose shows where the scene has none), so a flipped match (the ken's big cup on its
-// small cup) loses to the right one.
+// small cup) loses to the right one. Beyond the paper, planar scene patches are also paired with
+// the model's flat faces (plane hypotheses), for scenes that show one flat face.
 #pragma once
 
 #include <array>
@@ -52,6 +53,22 @@ struct InitialAlignmentConfig {
   /// The best few hypotheses are also tried turned by 180 degrees about each principal axis of
   /// the model (through its centroid): the end-for-end flips LRFs confuse.
   std::size_t flip_candidates = 2;
+  /// Plane hypotheses (our addition beyond the paper, which proposes poses from LRF pairs only,
+  /// Eq. 20): every large planar scene patch is paired with every flat model face (the face's
+  /// outward normal turned onto the patch's camera-facing normal, centroids matched) at
+  /// plane_rotations turns about the normal; the best plane_candidates of them join the refinement
+  /// and verification. This is what finds the cylinder seen end-on (a flat disc: no model LRF on
+  /// the flat cap). 0 turns it off.
+  std::size_t plane_rotations = 24;
+  std::size_t plane_candidates = 2;
+  PlaneConfig scene_planes{};  ///< large patches only (20 % of the S-PCD): cheap in the common case
+  PlaneConfig model_faces{.normal_tolerance_rad = 0.09F,
+                          .offset_tolerance = 0.5F,
+                          .min_extent = 1.0F,
+                          .min_fraction = 0.03F,
+                          .min_points = 8,
+                          .max_patches = 12,
+                          .max_seeds = 256};
   std::uint32_t seed = 1;  ///< for the LRF down-sampling
 };
 
@@ -61,12 +78,14 @@ struct InitialAlignmentResult {
   float rmse_m = 0.0F;   ///< ICP residual of the chosen pose
   std::size_t scene_lrfs = 0;
   std::size_t model_lrfs = 0;
-  std::size_t hypotheses = 0;  ///< LRF pairs scored
-  std::size_t candidates = 0;  ///< hypotheses refined and verified
-  float features_ms = 0.0F;    ///< wall time: scene features and LRFs (Eqs. 17-19)
-  float scoring_ms = 0.0F;     ///< wall time: LRF-pair scoring (Eq. 20)
-  float verify_ms = 0.0F;      ///< wall time: refinement and verification
-  bool valid = false;          ///< false when the scene has too few points or LRFs
+  std::size_t hypotheses = 0;        ///< LRF pairs scored
+  std::size_t scene_planes = 0;      ///< planar scene patches (plane hypotheses)
+  std::size_t plane_hypotheses = 0;  ///< plane/face pairs x turns scored
+  std::size_t candidates = 0;        ///< hypotheses refined and verified
+  float features_ms = 0.0F;          ///< wall time: scene features and LRFs (Eqs. 17-19)
+  float scoring_ms = 0.0F;           ///< wall time: LRF-pair scoring (Eq. 20)
+  float verify_ms = 0.0F;            ///< wall time: refinement and verification
+  bool valid = false;                ///< false when the scene has too few points or LRFs
 };
 
 /// A pose after the verification's ICP on the dense model samples, and its score.
@@ -94,6 +113,8 @@ class InitialAligner {
                                     const Eigen::Isometry3f& T_camera_model_guess);
 
   [[nodiscard]] const std::vector<Lrf>& model_lrfs() const { return model_lrfs_; }
+  /// The model's flat faces (outward normals) the plane hypotheses pair scene planes with.
+  [[nodiscard]] const std::vector<PlanarPatch>& model_faces() const { return model_faces_; }
   /// LRFs of the last scene (all, and the down-sampled ones used), for figures.
   [[nodiscard]] const std::vector<Lrf>& scene_lrfs() const { return scene_lrfs_; }
   [[nodiscard]] const std::vector<Lrf>& scene_lrfs_used() const { return scene_lrfs_used_; }
@@ -120,6 +141,7 @@ class InitialAligner {
   float spacing_m_ = 0.0F;                        // the M-PCD's mean point spacing
   std::array<Eigen::Isometry3f, 3> flips_model_;  // 180-degree turns about the principal axes
   std::vector<Lrf> model_lrfs_;
+  std::vector<PlanarPatch> model_faces_;
   std::vector<Lrf> scene_lrfs_;
   std::vector<Lrf> scene_lrfs_used_;
   Icp refine_;
