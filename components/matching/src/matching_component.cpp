@@ -141,6 +141,9 @@ class MatchingComponent final : public runtime::Component {
                                 "consecutive failed frames that declare the target lost"),
              ParamSpec::integer("min_scene_points", 15, 3, 100000, "",
                                 "fewer S-PCD points: no match (counts as a failure)"),
+             ParamSpec::integer("max_border_pixels", 20, -1, 100000, "px",
+                                "target-window pixels on the image border above which the "
+                                "target is cut off: no pose, re-initialise when whole (-1: off)"),
              ParamSpec::boolean("constant_velocity", true,
                                 "ICP starts from the constant-velocity prediction"),
              ParamSpec::real("lag_compensation_s", d.lag_compensation_s, 0.0, 0.1, "s",
@@ -242,6 +245,7 @@ class MatchingComponent final : public runtime::Component {
         static_cast<int>(ctx.param<std::int64_t>("failures_before_loss"));
     config.tracker.min_scene_points =
         static_cast<std::size_t>(ctx.param<std::int64_t>("min_scene_points"));
+    config.max_border_pixels = static_cast<int>(ctx.param<std::int64_t>("max_border_pixels"));
     config.tracker.constant_velocity = ctx.param<bool>("constant_velocity");
     config.lag_compensation_s = ctx.param<double>("lag_compensation_s");
     config.velocity_window_s = ctx.param<double>("velocity_window_s");

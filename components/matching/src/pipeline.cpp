@@ -56,6 +56,23 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
   }
 }
 
+std::size_t MatchingPipeline::border_pixels(const DepthView& depth) const {
+  const int w = depth.width_px;
+  const int h = depth.height_px;
+  const int stride = depth.stride_px > 0 ? depth.stride_px : w;
+  if (w <= 0 || h <= 0 || depth.depth_m == nullptr) return 0;
+  const auto in_window = [&](int u, int v) {
+    const float z = depth.depth_m[static_cast<std::ptrdiff_t>(v) * stride + u];
+    return z >= config_.depth_min_m && z <= config_.depth_max_m;  // NaN is false
+  };
+  std::size_t count = 0;
+  for (int u = 0; u < w; ++u)
+    count += (in_window(u, 0) ? 1 : 0) + (h > 1 && in_window(u, h - 1) ? 1 : 0);
+  for (int v = 1; v + 1 < h; ++v)
+    count += (in_window(0, v) ? 1 : 0) + (w > 1 && in_window(w - 1, v) ? 1 : 0);
+  return count;
+}
+
 PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s) {
   return process(depth, stamp_s, -1.0);
 }
@@ -70,6 +87,18 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
   scene_ = &builder_.build(depth, {}, config_.camera);
   out.valid_pixels = builder_.valid_pixels();
   out.scene_points = scene_->size();
+  out.border_pixels = border_pixels(depth);
+  out.truncated = config_.max_border_pixels >= 0 &&
+                  out.border_pixels > static_cast<std::size_t>(config_.max_border_pixels);
+  if (out.truncated) {
+    // Partly out of view: no pose, and a fresh initial alignment once the target is whole.
+    tracker_.reset();
+    history_.clear();
+    out.track.state = TrackingState::lost;
+    out.processing_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return out;
+  }
   out.track = tracker_.update(*scene_, stamp_s);
   out.has_pose = out.track.state == TrackingState::tracking;
   out.T_camera_model = out.track.T_camera_model;

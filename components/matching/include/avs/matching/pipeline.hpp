@@ -35,6 +35,11 @@ struct PipelineConfig {
   double velocity_window_s = 0.01;
   /// Also extrapolate the orientation (the angular velocity of a few tracked poses is noisy).
   bool lag_compensate_rotation = false;
+  /// A target cut by the image border (more than this many target-window pixels on the
+  /// outermost rows/columns) is only partly seen: ICP and the initial alignment would fit the
+  /// visible part anywhere, so the frame gives no pose and the tracker starts over when the
+  /// target is whole again. Negative: off.
+  int max_border_pixels = 20;
 };
 
 /// Per-frame result of MatchingPipeline::process().
@@ -47,7 +52,9 @@ struct PipelineOutput {
   bool lag_compensated = false;  ///< T_camera_model was extrapolated
   std::size_t valid_pixels = 0;
   std::size_t scene_points = 0;
-  double processing_ms = 0.0;  ///< wall-clock time of process()
+  std::size_t border_pixels = 0;  ///< target-window pixels on the image border
+  bool truncated = false;         ///< border_pixels > max_border_pixels: no pose
+  double processing_ms = 0.0;     ///< wall-clock time of process()
 };
 
 class MatchingPipeline {
@@ -70,6 +77,8 @@ class MatchingPipeline {
   [[nodiscard]] const Tracker& tracker() const { return tracker_; }
 
  private:
+  /// Target-window pixels on the outermost rows and columns.
+  [[nodiscard]] std::size_t border_pixels(const DepthView& depth) const;
   ModelCloud model_;
   PipelineConfig config_;
   SceneCloudBuilder builder_;
