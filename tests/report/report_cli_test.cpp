@@ -5,8 +5,8 @@
 #include <CLI/CLI.hpp>
 
 #include "avs/report/plots.hpp"
-#include "commands.hpp"
 #include "avs/report/run_data.hpp"
+#include "commands.hpp"
 #include "synthetic_run.hpp"
 
 namespace avs::cli {
@@ -46,6 +46,23 @@ TEST(ReportCommand, MakesTheReportOfARunFolder) {
   EXPECT_EQ(width, 640);
   EXPECT_EQ(height, 480);
   EXPECT_TRUE(std::filesystem::exists(tmp.path() / kIndexFile));
+}
+
+TEST(ReportCommand, MakesTheFiguresOfAFolderGivenRelativeToTheWorkingDirectory) {
+  testing::TempDir tmp("cli_relative");
+  {
+    RunRecorder recorder(tmp.path(), {"ken", "ken", "none", ""});
+    testing::SyntheticOptions options;
+    options.frames = 100;
+    for (const FrameRow& row : testing::make_frames(options)) recorder.write_frame(row);
+  }
+  // gnuplot runs inside the run folder: a relative folder name must still resolve.
+  const auto previous = std::filesystem::current_path();
+  std::filesystem::current_path(tmp.path().parent_path());
+  const int status = run_cli({"report", tmp.path().filename().string()});
+  std::filesystem::current_path(previous);
+  EXPECT_EQ(status, 0);
+  EXPECT_TRUE(std::filesystem::exists(tmp.path() / "fig15_position.png"));
 }
 
 TEST(ReportCommand, FailsOnAFolderWithoutData) {

@@ -42,7 +42,9 @@ void add_demo_command(CLI::App& app) {
   cmd->callback([] {
     run.scenario = "demo";
     run.tracking = !no_tracking;
-    run.dir = out.empty() ? default_run_dir("demo") : std::filesystem::path(out);
+    // Absolute: the report runs gnuplot inside the run folder.
+    run.dir = std::filesystem::absolute(out.empty() ? default_run_dir("demo")
+                                                    : std::filesystem::path(out));
     std::cerr << "avs demo: simulated closed loop, " << run.duration_s << " s of sim time in "
               << "lockstep (graph " << closed_loop_graph().string() << ", scene " << run.scene
               << "); Ctrl-C ends it early with a partial report\n";

@@ -129,7 +129,9 @@ void add_experiments_command(CLI::App& app) {
       exit_status() = 2;
       return;
     }
-    const std::filesystem::path root = out.empty() ? default_out_dir() : std::filesystem::path(out);
+    // Absolute: the report runs gnuplot inside each run folder.
+    const std::filesystem::path root =
+        std::filesystem::absolute(out.empty() ? default_out_dir() : std::filesystem::path(out));
     std::vector<std::pair<std::string, report::Summary>> summaries;
     std::string markdown;
     int status = 0;

@@ -122,7 +122,9 @@ std::string render_index_html(const RunInfo& info, const Summary& summary, const
   return h.str();
 }
 
-Report make_report(const fs::path& dir, const ReportOptions& options) {
+Report make_report(const fs::path& dir_given, const ReportOptions& options) {
+  // Absolute: gnuplot runs inside the run folder, so a relative path would not resolve there.
+  const fs::path dir = fs::absolute(dir_given);
   Report report;
   const RunData run = load_run(dir);
   report.info = run.info;
