@@ -15,6 +15,7 @@
 #include "avs/geometry/head_kinematics.hpp"
 #include "avs/matching/pipeline.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/depth_image.hpp"
 
 namespace avs::matching {
 
@@ -324,23 +325,17 @@ class MatchingComponent final : public runtime::Component {
   }
 
   void on_depth(const msgs::sensor_msgs::Image& image) {
-    const std::string_view encoding = runtime::get_string(image.encoding);
-    if (encoding != "32FC1" || image.is_bigendian != 0 || image.step % 4 != 0 ||
-        static_cast<std::uint64_t>(image.step) * image.height > image.data._length ||
-        image.step < 4ull * image.width) {
-      if (!warned_encoding_) {
-        log().error("depth image '", encoding, "' ", image.width, "x", image.height, " step ",
-                    image.step, " (", image.data._length,
-                    " bytes) ignored: expected little-endian 32FC1 metres");
-      }
+    std::string why;
+    const auto layout = runtime::depth_image_layout(image, &why);
+    if (!layout) {
+      if (!warned_encoding_) log().error(why, ": ignored");
       warned_encoding_ = true;
       return;
     }
     ++images_;
     const double stamp_s = runtime::from_ros_time(image.header.stamp).seconds();
-    const DepthView depth{reinterpret_cast<const float*>(image.data._buffer),
-                          static_cast<int>(image.width), static_cast<int>(image.height),
-                          static_cast<int>(image.step / 4)};
+    const DepthView depth{layout->depth_m, layout->width, layout->height,
+                          layout->row_stride_floats};
     const std::optional<double> age = age_at(stamp_s);
     if (age) ++aged_images_;
     const PipelineOutput out =

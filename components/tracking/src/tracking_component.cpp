@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/depth_image.hpp"
 #include "avs/tracking/tracker.hpp"
 
 namespace avs::tracking {
@@ -173,25 +174,20 @@ class TrackingComponent final : public runtime::Component {
   }
 
   void on_depth(const msgs::sensor_msgs::Image& image) {
-    const std::string_view encoding = runtime::get_string(image.encoding);
-    if (encoding != "32FC1" || image.is_bigendian != 0 || image.step % 4 != 0 ||
-        static_cast<std::uint64_t>(image.step) * image.height > image.data._length ||
-        image.step < 4ull * image.width) {
-      if (!warned_encoding_) {
-        log().error("depth image '", encoding, "' ", image.width, "x", image.height, " step ",
-                    image.step, " (", image.data._length,
-                    " bytes) ignored: expected little-endian 32FC1 metres");
-      }
+    std::string why;
+    const auto layout = runtime::depth_image_layout(image, &why);
+    if (!layout) {
+      if (!warned_encoding_) log().error(why, ": ignored");
       warned_encoding_ = true;
       return;
     }
     ++images_;
     const auto started = std::chrono::steady_clock::now();
     DepthImageView view;
-    view.depth_m = reinterpret_cast<const float*>(image.data._buffer);
-    view.width = static_cast<int>(image.width);
-    view.height = static_cast<int>(image.height);
-    view.row_stride_floats = image.step / 4;
+    view.depth_m = layout->depth_m;
+    view.width = layout->width;
+    view.height = layout->height;
+    view.row_stride_floats = static_cast<std::size_t>(layout->row_stride_floats);
     TargetObservation obs = measure_target(view, camera_, moments_);  // Eqs. 7-9
     if (obs.present) ++frames_with_target_;
     publish_target(image, obs);
