@@ -1,6 +1,7 @@
 #include "avs/runtime/container.hpp"
 
 #include <chrono>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -150,6 +151,8 @@ class ComponentHost final : public ComponentContext {
     std::lock_guard lock(stats_mutex_);
     return std::exchange(stats_, Stats{});
   }
+  /// The component's `rejected_samples` at the previous diagnostics report (diagnostics timer).
+  std::uint64_t reported_rejections = 0;
 
  private:
   void record_callback(std::chrono::steady_clock::duration d) {
@@ -303,6 +306,19 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
       } catch (const std::exception& e) {
         extra = {{"diagnostic_values_error", e.what()}};
       }
+    }
+    // Input rejected since the last report (SampleRejections' `rejected_samples`): WARN, so a
+    // monitor sees bad inputs without reading the values.
+    for (const auto& [key, value] : extra) {
+      if (key != "rejected_samples") continue;
+      const std::uint64_t rejected = std::strtoull(value.c_str(), nullptr, 10);
+      if (!failed && rejected > host.reported_rejections) {
+        status.level = 1;  // DiagnosticStatus WARN
+        set_string(status.message, "active, rejecting input samples (" +
+                                       std::to_string(rejected - host.reported_rejections) +
+                                       " since the last report)");
+      }
+      host.reported_rejections = rejected;
     }
     resize_sequence(status.values, static_cast<std::uint32_t>(kOwn + extra.size()));
     for (std::size_t k = 0; k < kOwn; ++k) {

@@ -8,8 +8,8 @@
 namespace avs::decode {
 namespace {
 
-LensModel distorted_lens() {
-  LensModel lens = default_sensor_geometry().camera;
+geometry::CameraModel distorted_lens() {
+  geometry::CameraModel lens = default_sensor_geometry().camera;
   lens.k1 = -0.12;
   lens.k2 = 0.05;
   lens.p1 = 0.001;
@@ -18,8 +18,8 @@ LensModel distorted_lens() {
   return lens;
 }
 
-TEST(LensModel, RayInvertsProjectWithDistortion) {
-  const LensModel lens = distorted_lens();
+TEST(CameraModel, RayInvertsProjectWithDistortion) {
+  const geometry::CameraModel lens = distorted_lens();
   for (int v = 0; v < lens.height; v += 37) {
     for (int u = 0; u < lens.width; u += 41) {
       const Eigen::Vector3d ray = lens.ray(u, v);

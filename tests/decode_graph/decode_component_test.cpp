@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -606,37 +607,105 @@ TEST(DecodeComponent, DropsAndTimingReachDiagnosticsOverDds) {
   EXPECT_TRUE(values.contains("callbacks")) << "the container's own values come first";
 }
 
-TEST(DecodeComponent, WrongFrameSizeFailsTheContainerLoudly) {
-  // A calibration for a 256 x 256 camera does not match the 512 x 512 frames.
+TEST(DecodeComponent, WrongFrameSizeIsRejectedAndCountedWithoutStoppingTheContainer) {
+  // A calibration for a 256 x 256 camera does not match the 512 x 512 frames: every frame is
+  // rejected with its reason and counted; the container runs to its end.
   const auto file = std::filesystem::temp_directory_path() /
                     ("avs_decode_cal_" + std::to_string(getpid()) + ".yaml");
   {
     std::ofstream out(file);
     out << "camera: {width: 256, height: 256, fx: 314.4, fy: 314.4, cx: 127.5, cy: 127.5}\n";
   }
-  setenv("AVS_DOMAIN_ID", "144", 1);
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("avs_decode_graph_bad_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string graph_file = (dir / "graph.yaml").string();
-  {
-    std::ofstream out(graph_file);
-    out << "domain_id: 144\nclock: {source: sim, mode: lockstep, duration_s: 0.01}\n"
-        << "containers:\n  - name: depth\n    components:\n"
-        << "      - {type: test_plane_patterns, name: source}\n"
-        << "      - {type: decode, name: decode, parameters: {calibration_file: " << file.string()
-        << "}}\n";
-  }
-  graph::LoadResult loaded = graph::load_graph(graph_file, {});
-  ASSERT_TRUE(loaded.ok());
-  runtime::Container container(*loaded.graph, loaded.graph->containers.front());
   testing::internal::CaptureStderr();
-  EXPECT_EQ(container.run(), 1);
+  const GraphRun run = run_graph(144, 0.02, "{calibration_file: " + file.string() + "}");
   const std::string err = testing::internal::GetCapturedStderr();
+  std::filesystem::remove(file);
+  ASSERT_NE(run.recorder, nullptr);
   EXPECT_NE(err.find("size 512x512, the calibration's camera is 256x256"), std::string::npos)
       << err;
-  std::filesystem::remove_all(dir);
-  std::filesystem::remove(file);
+  EXPECT_EQ(run.recorder->depth.size(), 0u);
+  EXPECT_EQ(run.count("rejected_samples"), static_cast<std::int64_t>(run.source->stamps_ns.size()));
+  EXPECT_EQ(run.count("frames_received"), 0);
+}
+
+/// Sends `count` malformed /camera/pattern frames from this (child) process once decode's
+/// reader is matched: bit index 200, bit count 0 and 16, rgb8, 0x0, short data, in turn.
+int publish_malformed_frames(int domain, int count) {
+  const runtime::dds::Participant participant(domain);
+  using Frame = msgs::avs_msgs::PatternFrame;
+  runtime::QosProfile qos;
+  qos.depth = 4;
+  const runtime::dds::Topic topic(participant, msg::TypeSupport<Frame>::descriptor(),
+                                  "rt/camera/pattern", qos);
+  runtime::dds::Writer writer(participant, topic, qos);
+  for (int wait = 0; writer.matched_readers() == 0; ++wait) {
+    if (wait > 2000) return 3;  // 20 s without decode's reader
+    usleep(10000);
+  }
+  for (int i = 0; i < count; ++i) {
+    auto m = runtime::make_sample<Frame>();
+    m->bit_count = kBits;
+    m->bit_index = 1;
+    auto& image = m->image;
+    runtime::set_string(image.encoding, "mono8");
+    image.width = image.height = image.step = 512;
+    std::uint32_t bytes = 512 * 512;
+    switch (i % 6) {
+      case 0:
+        m->bit_index = 200;
+        break;
+      case 1:
+        m->bit_count = 0;
+        break;
+      case 2:
+        m->bit_count = 16;
+        break;
+      case 3:
+        runtime::set_string(image.encoding, "rgb8");
+        break;
+      case 4:
+        image.width = image.height = image.step = 0;
+        bytes = 0;
+        break;
+      default:
+        bytes = 1000;
+        break;  // short data
+    }
+    runtime::resize_sequence(image.data, bytes);
+    writer.write(m.get());
+    usleep(5000);
+  }
+  usleep(200000);  // let reliable delivery finish before the participant goes
+  return 0;
+}
+
+TEST(DecodeComponent, MalformedFramesFromAnotherProcessAreRejectedAndDepthGoesOn) {
+  // Issue 13 section 3: a second process publishes malformed frames into a running decode
+  // graph; the container keeps producing depth from the good frames and the counter rises.
+  constexpr int kDomain = 147;
+  constexpr int kBad = 30;
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) _exit(publish_malformed_frames(kDomain, kBad));
+  // Long enough in sim time (lockstep: several seconds of wall time) for the child to be
+  // discovered and send everything while the graph runs.
+  const GraphRun run = run_graph(kDomain, 4.0, "{}");
+  int child_status = 0;
+  ASSERT_EQ(waitpid(child, &child_status, 0), child);
+  ASSERT_TRUE(WIFEXITED(child_status));
+  ASSERT_EQ(WEXITSTATUS(child_status), 0) << "the publisher never matched decode's reader";
+  ASSERT_NE(run.recorder, nullptr);
+  const std::int64_t rejected = run.count("rejected_samples");
+  EXPECT_GE(rejected, 1) << "no malformed frame reached decode";
+  EXPECT_LE(rejected, kBad);
+  // Every good pair still gave its depth map, none disturbed by the bad frames.
+  const std::size_t pairs = run.source->stamps_ns.size() / 2;
+  EXPECT_EQ(run.recorder->depth.size(), pairs);
+  EXPECT_EQ(run.count("dropped_frames"), 0);
+  EXPECT_EQ(run.count("out_of_order_frames"), 0);
+  for (std::size_t p = kBits - 1; p < run.recorder->depth.size(); ++p) {
+    expect_accurate(run.recorder->depth[p], "pair " + std::to_string(p) + " beside the bad frames");
+  }
 }
 
 }  // namespace

@@ -9,6 +9,12 @@ namespace {
 
 constexpr std::int64_t kMs = 1'000'000;
 
+/// The paper's camera (512 x 512, f = 628.8 px, principal point at the centre).
+geometry::CameraModel paper_camera() {
+  return {
+      .width = 512, .height = 512, .fx_px = 628.8, .fy_px = 628.8, .cx_px = 255.5, .cy_px = 255.5};
+}
+
 Truth truth_at(double x) {
   Truth t;
   t.world.p_world_m = {x, 0, 0};
@@ -19,7 +25,8 @@ Truth truth_at(double x) {
 
 TEST(FrameAssembler, OneRowPerDepthUpdateWithTheTruthOfItsStamp) {
   std::vector<report::FrameRow> rows;
-  FrameAssembler a({}, [&](const report::FrameRow& r) { rows.push_back(r); });
+  FrameAssembler a([&](const report::FrameRow& r) { rows.push_back(r); });
+  a.set_camera(paper_camera());
   for (int frame = 1; frame <= 10; ++frame) {
     const std::int64_t stamp = frame * kMs;
     a.on_truth(stamp, truth_at(frame));
@@ -60,7 +67,8 @@ TEST(FrameAssembler, OneRowPerDepthUpdateWithTheTruthOfItsStamp) {
 
 TEST(FrameAssembler, NoPoseWithoutAMatchStateThatHasOneAndNoRowWithoutTruth) {
   std::vector<report::FrameRow> rows;
-  FrameAssembler a({}, [&](const report::FrameRow& r) { rows.push_back(r); });
+  FrameAssembler a([&](const report::FrameRow& r) { rows.push_back(r); });
+  a.set_camera(paper_camera());
   a.on_truth(2 * kMs, truth_at(2));
   a.on_depth(2 * kMs);
   a.on_match(2 * kMs, report::MatchState::lost, 10, 0.1);
@@ -75,11 +83,28 @@ TEST(FrameAssembler, NoPoseWithoutAMatchStateThatHasOneAndNoRowWithoutTruth) {
 }
 
 TEST(FrameAssembler, TargetBehindOrOutsideTheImageIsNotInView) {
-  CameraModel camera;
-  EXPECT_TRUE(camera.in_view({0, 0, 1}));
-  EXPECT_FALSE(camera.in_view({0, 0, -1}));
-  EXPECT_FALSE(camera.in_view({0.5, 0, 1}));  // 314 px right of the centre: outside 512 px
-  EXPECT_TRUE(camera.in_view({0.35, 0, 1}));  // 220 px right: inside
+  const geometry::CameraModel camera = paper_camera();
+  EXPECT_TRUE(in_view(camera, {0, 0, 1}));
+  EXPECT_FALSE(in_view(camera, {0, 0, -1}));
+  EXPECT_FALSE(in_view(camera, {0.5, 0, 1}));  // 314 px right of the centre: outside 512 px
+  EXPECT_TRUE(in_view(camera, {0.35, 0, 1}));  // 220 px right: inside
+  // Barrel distortion pulls a point near the edge into the image.
+  geometry::CameraModel barrel = camera;
+  barrel.k1 = -0.3;
+  EXPECT_FALSE(in_view(camera, {0.42, 0, 1}));  // 264 px right: just outside the pinhole
+  EXPECT_TRUE(in_view(barrel, {0.42, 0, 1}));
+}
+
+TEST(FrameAssembler, WithoutACameraModelRowsAreNotInViewAndHaveNoCentroid) {
+  std::vector<report::FrameRow> rows;
+  FrameAssembler a([&](const report::FrameRow& r) { rows.push_back(r); });
+  a.on_truth(2 * kMs, truth_at(2));
+  a.on_target(2 * kMs, true, 300, 200);
+  a.on_depth(2 * kMs);
+  a.flush();
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_FALSE(rows[0].in_view);
+  EXPECT_FALSE(rows[0].centroid_px.has_value());
 }
 
 }  // namespace

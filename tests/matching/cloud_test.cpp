@@ -68,7 +68,7 @@ TEST(SceneCloud, StrideRatioFollowsEq27) {
 TEST(SceneCloud, RenderedCubeFaceHasTheRightDepth) {
   Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
   T_camera_model.translation() = Eigen::Vector3f(0.0F, 0.0F, 0.5F);
-  const CameraIntrinsics camera;
+  const geometry::CameraModel camera = test::test_camera();
   const DepthImage depth = render_depth(make_cube_mesh(0.1F), T_camera_model, camera);
   EXPECT_NEAR(depth.depth_m[256 * 512 + 256], 0.45F, 1e-5F);
   EXPECT_EQ(depth.depth_m[0], 0.0F);
@@ -94,7 +94,7 @@ TEST(SceneCloud, MaskSelectsPixels) {
   const ObjectPreset cube = builtin_objects()[1];
   Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
   T_camera_model.translation() = Eigen::Vector3f(0.0F, 0.0F, 0.5F);
-  const CameraIntrinsics camera;
+  const geometry::CameraModel camera = test::test_camera();
   const DepthImage depth = render_depth(cube.mesh, T_camera_model, camera);
   std::vector<std::uint8_t> mask(depth.depth_m.size(), 0);
   for (int v = 0; v < 512; ++v) {

@@ -5,6 +5,7 @@
 #include "avs/matching/model_cloud.hpp"
 #include "avs/matching/pipeline.hpp"
 #include "avs/matching/synthetic.hpp"
+#include "scene_fixture.hpp"
 
 namespace avs::matching {
 namespace {
@@ -21,6 +22,7 @@ Eigen::Isometry3f cube_at(float x_m) {
 TEST(MatchingPipeline, TargetCutByTheImageBorderGivesNoPose) {
   const geometry::Mesh cube = make_cube_mesh(0.1F);
   PipelineConfig config;
+  config.camera = test::paper_camera();
   MatchingPipeline pipeline(make_model_cloud(cube, ModelCloudConfig{.target_points = 488}), config);
 
   // Whole, centred: matched.

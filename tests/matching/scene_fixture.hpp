@@ -11,6 +11,19 @@ namespace avs::matching::test {
 
 inline constexpr float kDepthNoiseM = 0.0003F;  // 0.3 mm, seeded
 
+/// The synthetic tests' camera: 512 x 512 pinhole, f = 900 px, principal point at the centre.
+inline geometry::CameraModel test_camera() {
+  return {
+      .width = 512, .height = 512, .fx_px = 900.0, .fy_px = 900.0, .cx_px = 255.5, .cy_px = 255.5};
+}
+
+/// The paper's camera as decode::default_sensor_geometry() models it (f = 628.8 px).
+inline geometry::CameraModel paper_camera() {
+  geometry::CameraModel camera = test_camera();
+  camera.fx_px = camera.fy_px = 628.8;
+  return camera;
+}
+
 inline ModelCloud model_of(const ObjectPreset& object) {
   ModelCloudConfig config;
   config.target_points = object.model_points;
@@ -27,7 +40,7 @@ inline SceneCloudConfig scene_config_of(const ObjectPreset& object, const ModelC
 /// Renders the object at T_camera_model, adds seeded noise, builds the S-PCD.
 inline Points scene_of(const ObjectPreset& object, const ModelCloud& model,
                        const Eigen::Isometry3f& T_camera_model, std::uint32_t seed,
-                       const CameraIntrinsics& camera = {}) {
+                       const geometry::CameraModel& camera = test_camera()) {
   DepthImage depth = render_depth(object.mesh, T_camera_model, camera);
   add_depth_noise(depth, kDepthNoiseM, seed);
   SceneCloudBuilder builder(scene_config_of(object, model));

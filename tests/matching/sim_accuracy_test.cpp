@@ -104,13 +104,7 @@ Run run(const Setup& setup) {
   ModelCloudConfig model_config;
   model_config.target_points = object.model_points;
   PipelineConfig config;
-  const auto& lens = sim_config.renderer.geometry.camera;
-  config.camera = {static_cast<float>(lens.fx_px),
-                   static_cast<float>(lens.fy_px),
-                   static_cast<float>(lens.cx_px),
-                   static_cast<float>(lens.cy_px),
-                   lens.width,
-                   lens.height};
+  config.camera = sim_config.renderer.geometry.camera;  // one camera model, as sent
   config.scene.target_points = object.scene_points;
   if (setup.closed_loop_tuning) {
     config.tracker.dense_icp_model = true;

@@ -22,6 +22,8 @@
 #include "avs/graph/graph.hpp"
 #include "avs/matching/pipeline.hpp"
 #include "avs/matching/synthetic.hpp"
+#include "avs/msg/camera_info.hpp"
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
 
@@ -60,6 +62,9 @@ const geometry::HeadConfig& head_config() {
 class TestMatchingSource final : public runtime::Component {
  public:
   static ComponentSpec spec() {
+    runtime::QosProfile latched;  // as decode publishes /depth/camera_info
+    latched.durability = runtime::Durability::transient_local;
+    latched.depth = 1;
     return {
         .type = "test_matching_source",
         .description = "tests: joint states at 1 kHz and depth images of the ken at 500 Hz",
@@ -68,7 +73,9 @@ class TestMatchingSource final : public runtime::Component {
                                        "(negative: no /depth/info)")},
         .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
                       runtime::port<msgs::sensor_msgs::JointState>("joints", "/head/joint_states"),
-                      runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info")},
+                      runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info"),
+                      runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
+                                                                   "/depth/camera_info", latched)},
         .subscribes = {}};
   }
   explicit TestMatchingSource(ComponentContext& ctx)
@@ -76,9 +83,14 @@ class TestMatchingSource final : public runtime::Component {
         depth_(ctx.publisher<msgs::sensor_msgs::Image>("depth")),
         joints_(ctx.publisher<msgs::sensor_msgs::JointState>("joints")),
         info_(ctx.publisher<msgs::avs_msgs::DepthInfo>("info")),
+        camera_info_(ctx.publisher<msgs::sensor_msgs::CameraInfo>("camera_info")),
         info_age_s_(ctx.param<double>("info_age_s")),
         mesh_(load_object_model("ken").mesh) {}
   void on_activate() override {
+    // As decode does: the camera model before the first image (matching keeps none of its own).
+    auto info = runtime::make_sample<msgs::sensor_msgs::CameraInfo>();
+    msg::to_camera_info(camera_, *info);
+    camera_info_.publish(std::move(info));
     context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
   }
 
@@ -98,13 +110,7 @@ class TestMatchingSource final : public runtime::Component {
     if (tick_++ % 2 != 1) return;  // depth at 500 Hz, stamped at odd milliseconds
     const Eigen::Isometry3d T_camera_ken =
         geometry::T_world_camera(head_config(), pan_at(t), kTilt).inverse() * T_world_ken(t);
-    CameraIntrinsics camera{static_cast<float>(kF),
-                            static_cast<float>(kF),
-                            static_cast<float>(kC),
-                            static_cast<float>(kC),
-                            512,
-                            512};
-    const DepthImage image = render_depth(mesh_, T_camera_ken.cast<float>(), camera);
+    const DepthImage image = render_depth(mesh_, T_camera_ken.cast<float>(), camera_);
     auto m = runtime::make_sample<msgs::sensor_msgs::Image>();
     runtime::to_ros_time(now, m->header.stamp);
     runtime::set_string(m->header.frame_id, "camera");
@@ -136,6 +142,9 @@ class TestMatchingSource final : public runtime::Component {
   runtime::Publisher<msgs::sensor_msgs::Image> depth_;
   runtime::Publisher<msgs::sensor_msgs::JointState> joints_;
   runtime::Publisher<msgs::avs_msgs::DepthInfo> info_;
+  runtime::Publisher<msgs::sensor_msgs::CameraInfo> camera_info_;
+  const geometry::CameraModel camera_{
+      .width = 512, .height = 512, .fx_px = kF, .fy_px = kF, .cx_px = kC, .cy_px = kC};
   double info_age_s_;
   geometry::Mesh mesh_;
   std::uint64_t tick_ = 0;
@@ -146,16 +155,6 @@ struct PoseRecord {
   std::string frame;
   Eigen::Isometry3d T;
 };
-
-Eigen::Isometry3d from_msg(const msgs::geometry_msgs::Pose& p) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() =
-      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
-          .normalized()
-          .toRotationMatrix();
-  T.translation() = Eigen::Vector3d(p.position.x, p.position.y, p.position.z);
-  return T;
-}
 
 class TestMatchingRecorder final : public runtime::Component {
  public:
@@ -175,7 +174,8 @@ class TestMatchingRecorder final : public runtime::Component {
     auto pose_cb = [](std::vector<PoseRecord>& out) {
       return [&out](runtime::SamplePtr<msgs::geometry_msgs::PoseStamped> m) {
         out.push_back({runtime::from_ros_time(m->header.stamp).ns,
-                       std::string(runtime::get_string(m->header.frame_id)), from_msg(m->pose)});
+                       std::string(runtime::get_string(m->header.frame_id)),
+                       msg::to_isometry(m->pose)});
       };
     };
     ctx.subscribe<msgs::geometry_msgs::PoseStamped>("pose", pose_cb(camera));

@@ -22,7 +22,8 @@ struct Image {
   }
 };
 
-const CameraIntrinsics camera{100.0, 100.0, 31.5, 23.5};
+const geometry::CameraModel camera{
+    .width = 64, .height = 48, .fx_px = 100.0, .fy_px = 100.0, .cx_px = 31.5, .cy_px = 23.5};
 
 TEST(Moments, RectangleGivesAreaCentroidAndMeanDepth) {
   Image img;
@@ -71,6 +72,26 @@ TEST(Moments, RowStrideIsHonoured) {
   EXPECT_DOUBLE_EQ(obs.m00, 1);
   EXPECT_DOUBLE_EQ(obs.centroid_u_px, 3);
   EXPECT_DOUBLE_EQ(obs.centroid_v_px, 7);
+}
+
+TEST(Moments, WithLensDistortionTheCentroidIsUndistortedForTheServoLaw) {
+  // A target off centre under barrel distortion: the image centroid sits nearer the centre
+  // than the ideal pinhole's; m_g (what Eq. 10 relates to the direction) is the undistorted one.
+  geometry::CameraModel lens = camera;
+  lens.k1 = -0.2;
+  lens.k2 = 0.05;
+  Image img;
+  img.fill_rect(50, 30, 6, 6, 1.0f);  // u 50..55, v 30..35: centroid (52.5, 32.5)
+  const TargetObservation obs = measure_target(img.view(), lens, {0.5, 1.5, 10});
+  ASSERT_TRUE(obs.present);
+  EXPECT_DOUBLE_EQ(obs.centroid_u_px, 52.5);
+  EXPECT_DOUBLE_EQ(obs.centroid_v_px, 32.5);
+  const Eigen::Vector3d ray = lens.ray(52.5, 32.5);
+  EXPECT_NEAR(obs.m_g_px.x(), 100.0 * ray.x(), 1e-9);
+  EXPECT_NEAR(obs.m_g_px.y(), 100.0 * ray.y(), 1e-9);
+  EXPECT_GT(obs.m_g_px.x(), 52.5 - 31.5);  // barrel: the ideal point lies farther out
+  const TargetObservation pinhole = measure_target(img.view(), camera, {0.5, 1.5, 10});
+  EXPECT_DOUBLE_EQ(pinhole.m_g_px.x(), 52.5 - 31.5);
 }
 
 }  // namespace

@@ -39,9 +39,17 @@ void add_demo_command(CLI::App& app) {
   cmd->add_option("--symmetry", run.symmetry, "object symmetry: none, cube, cylinder_x|y|z")
       ->capture_default_str();
   cmd->add_flag("--no-tracking", no_tracking, "the head holds still (Sec. 7.1.2)");
+  static std::string calibration;
+  cmd->add_option("--calibration", calibration,
+                  "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
+                  "decoder; the other components take it from /depth/camera_info")
+      ->check(CLI::ExistingFile);
   cmd->callback([] {
     run.scenario = "demo";
     run.tracking = !no_tracking;
+    if (!calibration.empty()) {
+      run.extra_args["calibration"] = std::filesystem::absolute(calibration).string();
+    }
     // Absolute: the report runs gnuplot inside the run folder.
     run.dir = std::filesystem::absolute(out.empty() ? default_run_dir("demo")
                                                     : std::filesystem::path(out));

@@ -113,7 +113,13 @@ void add_experiments_command(CLI::App& app) {
   static bool json = false;
   static std::string out;
   static double time_scale = 1.0;
+  static std::string calibration;
   cmd->add_option("NAME", names, "experiments to run (default: all)");
+  cmd->add_option("--calibration", calibration,
+                  "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
+                  "decoder only; tracking, matching and the recorder take the camera model "
+                  "from /depth/camera_info (default: the paper's sensor)")
+      ->check(CLI::ExistingFile);
   cmd->add_flag("--json", json, "print one JSON object keyed by scenario name on stdout");
   cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
   cmd->add_option("--time-scale", time_scale,
@@ -139,6 +145,11 @@ void add_experiments_command(CLI::App& app) {
       if (interrupted_by_signal()) break;
       e.run.dir = root / e.name;
       e.run.duration_s *= time_scale;
+      if (!calibration.empty()) {
+        e.run.extra_args["calibration"] = std::filesystem::absolute(calibration).string();
+        e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("calibration ") +
+                       std::filesystem::path(calibration).filename().string();
+      }
       std::cerr << "== " << e.name << " (Sec. " << e.section << "): " << e.what << "\n";
       const ClosedLoopOutcome outcome = run_closed_loop(e.run, std::cerr);
       if (outcome.status != 0) status = outcome.status;

@@ -55,7 +55,7 @@ std::vector<double> read_list(const std::string& source, const YAML::Node& node,
 }
 
 void read_lens(const std::string& source, const YAML::Node& node, const std::string& section,
-               LensModel& lens) {
+               geometry::CameraModel& lens) {
   check_keys(source, node, {"width", "height", "fx", "fy", "cx", "cy", "distortion"}, section);
   read(source, node, "width", lens.width);
   read(source, node, "height", lens.height);
@@ -63,16 +63,18 @@ void read_lens(const std::string& source, const YAML::Node& node, const std::str
   read(source, node, "fy", lens.fy_px);
   read(source, node, "cx", lens.cx_px);
   read(source, node, "cy", lens.cy_px);
-  if (node["distortion"]) {
-    const auto d = read_list(source, node["distortion"], 5, "distortion");
-    lens.k1 = d[0], lens.k2 = d[1], lens.p1 = d[2], lens.p2 = d[3], lens.k3 = d[4];
+  if (const YAML::Node d_node = node["distortion"]) {
+    // 5 (k1 k2 p1 p2 k3, plumb_bob) or 8 (and k4 k5 k6, rational_polynomial), OpenCV order.
+    const std::size_t count = d_node.IsSequence() && d_node.size() == 8 ? 8 : 5;
+    const auto d = read_list(source, d_node, count, "distortion");
+    lens.set_distortion_coefficients(d);
   }
-  if (lens.width <= 0 || lens.height <= 0 || lens.fx_px <= 0 || lens.fy_px <= 0) {
-    fail(source, node, section + ": width, height, fx and fy must be positive");
+  if (const std::string why = lens.problem(); !why.empty()) {
+    fail(source, node, section + ": " + why);
   }
 }
 
-void write_lens(YAML::Emitter& out, const char* name, const LensModel& lens) {
+void write_lens(YAML::Emitter& out, const char* name, const geometry::CameraModel& lens) {
   out << YAML::Key << name << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "width" << YAML::Value << lens.width << YAML::Key << "height" << YAML::Value
       << lens.height;
@@ -80,8 +82,7 @@ void write_lens(YAML::Emitter& out, const char* name, const LensModel& lens) {
       << lens.fy_px;
   out << YAML::Key << "cx" << YAML::Value << lens.cx_px << YAML::Key << "cy" << YAML::Value
       << lens.cy_px;
-  out << YAML::Key << "distortion" << YAML::Value << YAML::Flow
-      << std::vector<double>{lens.k1, lens.k2, lens.p1, lens.p2, lens.k3};
+  out << YAML::Key << "distortion" << YAML::Value << YAML::Flow << lens.distortion_coefficients();
   out << YAML::EndMap;
 }
 

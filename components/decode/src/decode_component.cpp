@@ -3,9 +3,11 @@
 // their bit index and cycle counter (never by arrival); every completed positive/negative pair
 // gives a depth map (Eqs. 2-4, 500 Hz from 1000 fps) on /depth/image (32FC1, metres, NaN
 // invalid, stamp of the newest frame used), optionally a PointCloud2 on /depth/points, the
-// map's data age on /depth/info (same stamp) and the wall-clock processing time of the pair on
-// /timing. Dropped and out-of-order frames are counted
-// by the decoder and reported on /diagnostics.
+// map's data age on /depth/info and the camera model in force on /depth/camera_info (both with
+// the same stamp; camera_info is also latched, transient-local, from activation on) and the
+// wall-clock processing time of the pair on /timing. Dropped and out-of-order frames are counted
+// by the decoder and reported on /diagnostics; a malformed frame is rejected with its reason
+// (counted as rejected_samples), never stops the container.
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -13,7 +15,11 @@
 
 #include "avs/decode/calibration_yaml.hpp"
 #include "avs/decode/rolling_decoder.hpp"
+#include "avs/msg/camera_info.hpp"
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/config_params.hpp"
+#include "avs/runtime/rejections.hpp"
 
 namespace avs::decode {
 
@@ -61,16 +67,18 @@ class DecodeComponent final : public runtime::Component {
     points_qos.depth = 2;
     runtime::QosProfile keep_last_100;
     keep_last_100.depth = 100;
+    // Latched: a subscriber that starts later still gets the camera model before any image.
+    runtime::QosProfile latched;
+    latched.durability = runtime::Durability::transient_local;
+    latched.depth = 1;
     return {
         .type = "decode",
         .description =
             "Gray-code depth (section 4): /camera/pattern frames -> rolling decode with code "
             "correction and ray x plane triangulation -> /depth/image (32FC1 m) per pair, "
-            "optional /depth/points, /timing",
-        .parameters =
-            {ParamSpec::integer("threshold_psi", 10, 0, 255, "",
-                                "Eq. 2: |I_pos - I_neg| must exceed psi (8-bit units)"),
-             ParamSpec::integer("bit_count", 0, 0, 15, "",
+            "/depth/camera_info, /depth/info, optional /depth/points, /timing",
+        .parameters = params().specs_with(
+            {ParamSpec::integer("bit_count", 0, 0, 15, "",
                                 "n code bits; 0: from the calibration (default 9)"),
              ParamSpec::integer("code_count", 0, 0, 32768, "",
                                 "codes used; 0: from the calibration (default 265)"),
@@ -81,41 +89,54 @@ class DecodeComponent final : public runtime::Component {
              ParamSpec::string("calibration_file", "",
                                "sensor geometry YAML (docs/decode.md); empty: the paper's "
                                "sensor, default_sensor_geometry()"),
-             ParamSpec::boolean("code_correction", true,
-                                "Algorithm 1 (section 4.4); ignored in full_cycle mode"),
              ParamSpec::string("mode", "rolling",
                                "rolling: a depth map per pair (500 Hz); full_cycle: one per "
                                "complete 2n-frame cycle, no correction",
                                {"rolling", "full_cycle"}),
-             ParamSpec::integer("max_bit_age_pairs", 0, 0, 1000, "",
-                                "use a bit while at most this many pairs old; 0: n (rolling "
-                                "only; 2n rides a static scene through a drop)"),
-             ParamSpec::real("min_depth_m", 0.05, 0.0, 1000.0, "m", "nearer depths are NaN"),
-             ParamSpec::real("max_depth_m", 20.0, 0.0, 1000.0, "m", "farther depths are NaN"),
-             ParamSpec::string("triangulation", "table",
-                               "table: ray x plane look-up; reference: per-pixel 3x3 solve "
-                               "of Eq. 4 (slow, for comparison)",
-                               {"table", "reference"}),
-             ParamSpec::integer("subcode_half_window", 0, 0, 16, "px",
-                                "sub-code refinement: fit the codes of 2h+1 rows of each "
-                                "column, triangulate the fitted fractional code; 0: off "
-                                "(code centres). Table triangulation only; ~0.6 ms per update"),
-             ParamSpec::integer("subcode_max_jump", 2, 0, 1000, "",
-                                "codes per row that mark a discontinuity (the pixel keeps its "
-                                "plain code)"),
-             ParamSpec::integer("subcode_steps", 16, 1, 256, "",
-                                "sub-code planes per code (the fitted code's resolution)"),
              ParamSpec::boolean("publish_points", false,
                                 "also publish /depth/points (organised XYZ float32)"),
-             ParamSpec::string("frame_id", "camera", "header.frame_id of depth and points")},
+             ParamSpec::string("frame_id", "camera", "header.frame_id of depth and points")}),
         .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
                       runtime::port<msgs::sensor_msgs::PointCloud2>("points", "/depth/points",
                                                                     points_qos),
                       runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing",
                                                                  keep_last_100),
-                      runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info", keep_last_4)},
+                      runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info", keep_last_4),
+                      runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
+                                                                   "/depth/camera_info", latched)},
         .subscribes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
-                                                                   keep_last_4)}};
+                                                                   keep_last_4)},
+        .default_mismatches = [] { return params().default_mismatches(); }};
+  }
+
+  /// Parameters bound to DecoderConfig (its defaults are the parameters').
+  static const runtime::ConfigParams<DecoderConfig>& params() {
+    static const auto p =
+        runtime::ConfigParams<DecoderConfig>()
+            .integer("threshold_psi", AVS_FIELD(threshold_psi), 0, 255, "",
+                     "Eq. 2: |I_pos - I_neg| must exceed psi (8-bit units)")
+            .boolean("code_correction", AVS_FIELD(code_correction),
+                     "Algorithm 1 (section 4.4); ignored in full_cycle mode")
+            .integer("max_bit_age_pairs", AVS_FIELD(max_bit_age_pairs), 0, 1000, "",
+                     "use a bit while at most this many pairs old; 0: n (rolling only; 2n rides "
+                     "a static scene through a drop)")
+            .real("min_depth_m", AVS_FIELD(min_depth_m), 0.0, 1000.0, "m", "nearer depths are NaN")
+            .real("max_depth_m", AVS_FIELD(max_depth_m), 0.0, 1000.0, "m", "farther depths are NaN")
+            .choice("triangulation", AVS_FIELD(triangulation),
+                    std::vector<std::pair<std::string, TriangulationMethod>>{
+                        {"table", TriangulationMethod::kRayPlaneTable},
+                        {"reference", TriangulationMethod::kReferenceSolve}},
+                    "table: ray x plane look-up; reference: per-pixel 3x3 solve of Eq. 4 (slow, "
+                    "for comparison)")
+            .integer("subcode_half_window", AVS_FIELD(subcode_half_window), 0, 16, "px",
+                     "sub-code refinement: fit the codes of 2h+1 rows of each column, "
+                     "triangulate the fitted fractional code; 0: off (code centres). Table "
+                     "triangulation only; ~0.6 ms per update")
+            .integer("subcode_max_jump", AVS_FIELD(subcode_max_jump), 0, 1000, "",
+                     "codes per row that mark a discontinuity (the pixel keeps its plain code)")
+            .integer("subcode_steps", AVS_FIELD(subcode_steps), 1, 256, "",
+                     "sub-code planes per code (the fitted code's resolution)");
+    return p;
   }
 
   explicit DecodeComponent(ComponentContext& ctx)
@@ -124,10 +145,12 @@ class DecodeComponent final : public runtime::Component {
         points_(ctx.publisher<msgs::sensor_msgs::PointCloud2>("points")),
         timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
         info_(ctx.publisher<msgs::avs_msgs::DepthInfo>("info")),
+        camera_info_(ctx.publisher<msgs::sensor_msgs::CameraInfo>("camera_info")),
         full_cycle_(ctx.param<std::string>("mode") == "full_cycle"),
         publish_points_(ctx.param<bool>("publish_points")),
         frame_id_(ctx.param<std::string>("frame_id")),
-        decoder_(make_config(ctx)) {
+        decoder_(make_config(ctx)),
+        rejected_(ctx.log(), "/camera/pattern frame") {
     const SensorGeometry& g = decoder_.config().geometry;
     width_ = g.camera.width;
     height_ = g.camera.height;
@@ -141,6 +164,8 @@ class DecodeComponent final : public runtime::Component {
                decoder_.config().code_correction ? "on" : "off", ", sub-code half window ",
                decoder_.config().subcode_half_window);
   }
+
+  void on_activate() override { publish_camera_info(nullptr); }
 
   void on_deactivate() override {
     const DecoderStats s = decoder_.stats();
@@ -161,7 +186,8 @@ class DecodeComponent final : public runtime::Component {
             {"processing_ms_mean",
              std::to_string(published_ > 0 ? total_ms_ / static_cast<double>(published_) : 0.0)},
             {"processing_ms_max", std::to_string(max_ms_)},
-            {"processing_ms_last", std::to_string(last_ms_)}};
+            {"processing_ms_last", std::to_string(last_ms_)},
+            rejected_.diagnostic()};
   }
 
   /// Decoder statistics (for tests; same numbers as diagnostic_values()).
@@ -172,19 +198,8 @@ class DecodeComponent final : public runtime::Component {
 
  private:
   static DecoderConfig make_config(ComponentContext& ctx) {
-    DecoderConfig c;
+    DecoderConfig c = params().make(ctx.parameters());
     c.geometry = make_geometry(ctx);
-    c.threshold_psi = ctx.param<int>("threshold_psi");
-    c.code_correction = ctx.param<bool>("code_correction");
-    c.max_bit_age_pairs = ctx.param<int>("max_bit_age_pairs");
-    c.subcode_half_window = ctx.param<int>("subcode_half_window");
-    c.subcode_max_jump = ctx.param<int>("subcode_max_jump");
-    c.subcode_steps = ctx.param<int>("subcode_steps");
-    c.min_depth_m = static_cast<float>(ctx.param<double>("min_depth_m"));
-    c.max_depth_m = static_cast<float>(ctx.param<double>("max_depth_m"));
-    c.triangulation = ctx.param<std::string>("triangulation") == "reference"
-                          ? TriangulationMethod::kReferenceSolve
-                          : TriangulationMethod::kRayPlaneTable;
     if (!(c.min_depth_m < c.max_depth_m)) {
       throw std::invalid_argument("decode: min_depth_m must be below max_depth_m");
     }
@@ -197,7 +212,8 @@ class DecodeComponent final : public runtime::Component {
     return c;
   }
 
-  void check_frame(const msgs::avs_msgs::PatternFrame& m) const {
+  /// Why the frame cannot be decoded, or empty.
+  std::string frame_problem(const msgs::avs_msgs::PatternFrame& m) const {
     const auto& image = m.image;
     const std::string_view encoding = runtime::get_string(image.encoding);
     std::string problem;
@@ -216,17 +232,20 @@ class DecodeComponent final : public runtime::Component {
       problem = "bit_count " + std::to_string(m.bit_count) + ", the decoder uses " +
                 std::to_string(bit_count_) + " (parameter bit_count / calibration code_layout)";
     } else if (m.bit_index >= bit_count_) {
-      problem = "bit_index " + std::to_string(m.bit_index);
+      problem = "bit_index " + std::to_string(m.bit_index) + ", expected 0.." +
+                std::to_string(bit_count_ - 1);
     }
-    if (!problem.empty()) {
-      throw std::invalid_argument("decode: pattern frame (cycle " + std::to_string(m.cycle) +
-                                  ", bit " + std::to_string(m.bit_index) + ") has " + problem);
-    }
+    if (problem.empty()) return {};
+    return "pattern frame (cycle " + std::to_string(m.cycle) + ", bit " +
+           std::to_string(m.bit_index) + ") has " + problem;
   }
 
   void on_frame(const msgs::avs_msgs::PatternFrame& m) {
     const auto start = std::chrono::steady_clock::now();
-    check_frame(m);
+    if (std::string problem = frame_problem(m); !problem.empty()) {
+      rejected_.reject(problem);
+      return;
+    }
     PatternFrame frame;
     frame.image = {m.image.data._buffer, width_, height_,
                    static_cast<std::ptrdiff_t>(m.image.step)};
@@ -289,6 +308,7 @@ class DecodeComponent final : public runtime::Component {
       info->data_age_s = (2.0 * result.effective_age_pairs + 0.5) * frame_period_s_;
       info_.publish(std::move(info));
     }
+    publish_camera_info(&m.header.stamp);
     depth_.publish(std::move(image));
 
     const double ms = pending_ms_ + ms_since(start);
@@ -325,6 +345,16 @@ class DecodeComponent final : public runtime::Component {
     }
   }
 
+  /// The camera model in force (the calibration's camera) as sensor_msgs/CameraInfo, with the
+  /// stamp of the depth image it goes with (none: zero, the latched copy at activation).
+  void publish_camera_info(const msgs::builtin_interfaces::Time* stamp) {
+    auto info = runtime::make_sample<msgs::sensor_msgs::CameraInfo>();
+    msg::to_camera_info(decoder_.config().geometry.camera, *info);
+    if (stamp != nullptr) info->header.stamp = *stamp;
+    runtime::set_string(info->header.frame_id, frame_id_);
+    camera_info_.publish(std::move(info));
+  }
+
   /// Organised XYZ cloud (float32 x, y, z; NaN invalid) from the depth just computed:
   /// X = z x, Y = z y, Z = z with the undistorted ray (x, y, 1) of each pixel.
   void publish_points(const msgs::sensor_msgs::Image& depth_image) {
@@ -333,17 +363,7 @@ class DecodeComponent final : public runtime::Component {
     runtime::set_string(cloud->header.frame_id, frame_id_);
     cloud->height = static_cast<std::uint32_t>(height_);
     cloud->width = static_cast<std::uint32_t>(width_);
-    runtime::resize_sequence(cloud->fields, 3);
-    const char* names[3] = {"x", "y", "z"};
-    for (std::uint32_t i = 0; i < 3; ++i) {
-      auto& field = cloud->fields._buffer[i];
-      runtime::set_string(field.name, names[i]);
-      field.offset = 4 * i;
-      field.datatype = 7;  // PointField FLOAT32
-      field.count = 1;
-    }
-    cloud->is_bigendian = false;
-    cloud->point_step = 12;
+    msg::set_xyz_fields(*cloud);
     cloud->row_step = static_cast<std::uint32_t>(12 * width_);
     cloud->is_dense = false;
     const std::size_t pixels = static_cast<std::size_t>(width_) * height_;
@@ -364,6 +384,7 @@ class DecodeComponent final : public runtime::Component {
   runtime::Publisher<msgs::sensor_msgs::PointCloud2> points_;
   runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
   runtime::Publisher<msgs::avs_msgs::DepthInfo> info_;
+  runtime::Publisher<msgs::sensor_msgs::CameraInfo> camera_info_;
   bool full_cycle_;
   double frame_period_s_ = 0.0;
   double previous_stamp_s_ = 0.0;
@@ -373,6 +394,7 @@ class DecodeComponent final : public runtime::Component {
   bool publish_points_;
   std::string frame_id_;
   RollingDecoder decoder_;
+  runtime::SampleRejections rejected_;
   int width_ = 0;
   int height_ = 0;
   int bit_count_ = 0;

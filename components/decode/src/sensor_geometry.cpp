@@ -7,43 +7,6 @@
 
 namespace avs::decode {
 
-Eigen::Matrix3d LensModel::intrinsic_matrix() const {
-  Eigen::Matrix3d K;
-  K << fx_px, 0, cx_px, 0, fy_px, cy_px, 0, 0, 1;
-  return K;
-}
-
-Eigen::Vector2d LensModel::distort(const Eigen::Vector2d& xy) const {
-  const double x = xy.x(), y = xy.y();
-  const double r2 = x * x + y * y;
-  const double radial = 1 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  return {x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x),
-          y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y};
-}
-
-Eigen::Vector2d LensModel::undistort(const Eigen::Vector2d& xy_distorted) const {
-  if (!has_distortion()) return xy_distorted;
-  // Fixed-point iteration as in OpenCV's undistortPoints, run to convergence.
-  Eigen::Vector2d xy = xy_distorted;
-  for (int iteration = 0; iteration < 100; ++iteration) {
-    const Eigen::Vector2d residual = distort(xy) - xy_distorted;
-    xy -= residual;
-    if (residual.squaredNorm() < 1e-26) break;
-  }
-  return xy;
-}
-
-Eigen::Vector2d LensModel::project(const Eigen::Vector3d& p) const {
-  const Eigen::Vector2d xy = distort(Eigen::Vector2d(p.x() / p.z(), p.y() / p.z()));
-  return {fx_px * xy.x() + cx_px, fy_px * xy.y() + cy_px};
-}
-
-Eigen::Vector3d LensModel::ray(double u_px, double v_px) const {
-  const Eigen::Vector2d xy =
-      undistort(Eigen::Vector2d((u_px - cx_px) / fx_px, (v_px - cy_px) / fy_px));
-  return {xy.x(), xy.y(), 1.0};
-}
-
 Eigen::Matrix<double, 3, 4> SensorGeometry::camera_matrix() const {
   Eigen::Matrix<double, 3, 4> Rt = Eigen::Matrix<double, 3, 4>::Zero();
   Rt.leftCols<3>().setIdentity();

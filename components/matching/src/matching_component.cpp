@@ -13,78 +13,20 @@
 #include <utility>
 
 #include "avs/geometry/head_kinematics.hpp"
+#include "avs/matching/joint_history.hpp"
 #include "avs/matching/pipeline.hpp"
+#include "avs/msg/camera_input.hpp"
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/config_params.hpp"
 #include "avs/runtime/depth_image.hpp"
+#include "avs/runtime/rejections.hpp"
 
 namespace avs::matching {
 
 using runtime::ComponentContext;
 using runtime::ComponentSpec;
 using runtime::ParamSpec;
-
-namespace {
-
-Eigen::Vector3d triple(const std::vector<double>& v, const std::string& name) {
-  if (v.size() != 3) {
-    throw std::invalid_argument("parameter '" + name + "' needs 3 values (x, y, z), got " +
-                                std::to_string(v.size()));
-  }
-  return {v[0], v[1], v[2]};
-}
-
-template <class Pose>
-void set_pose(const Eigen::Isometry3d& T, Pose& pose) {
-  const Eigen::Quaterniond q(T.linear());
-  pose.position.x = T.translation().x();
-  pose.position.y = T.translation().y();
-  pose.position.z = T.translation().z();
-  pose.orientation.x = q.x();
-  pose.orientation.y = q.y();
-  pose.orientation.z = q.z();
-  pose.orientation.w = q.w();
-}
-
-}  // namespace
-
-/// Joint angles at a given time from a short history of joint states: linear interpolation
-/// between the two samples around it; beyond the newest sample, extrapolation at the last
-/// velocity for at most max_extrapolation_s.
-class JointHistory {
- public:
-  struct Sample {
-    double t_s;
-    double pan_rad, tilt_rad;
-  };
-  void add(const Sample& s) {
-    if (!samples_.empty() && s.t_s < samples_.back().t_s) samples_.clear();  // time went back
-    if (!samples_.empty() && s.t_s == samples_.back().t_s) samples_.pop_back();
-    samples_.push_back(s);
-    while (samples_.size() > 2 && samples_.back().t_s - samples_.front().t_s > keep_s_) {
-      samples_.pop_front();
-    }
-  }
-  [[nodiscard]] bool empty() const { return samples_.empty(); }
-  [[nodiscard]] std::optional<Sample> at(double t_s, double max_extrapolation_s) const {
-    if (samples_.empty()) return std::nullopt;
-    if (samples_.size() == 1 || t_s <= samples_.front().t_s) {
-      if (samples_.front().t_s - t_s > max_extrapolation_s) return std::nullopt;
-      return samples_.front();
-    }
-    std::size_t i = 1;
-    while (i + 1 < samples_.size() && samples_[i].t_s < t_s) ++i;
-    const Sample& a = samples_[i - 1];
-    const Sample& b = samples_[i];
-    if (t_s - b.t_s > max_extrapolation_s) return std::nullopt;  // history too old
-    const double w = (t_s - a.t_s) / (b.t_s - a.t_s);            // > 1: extrapolation
-    return Sample{t_s, a.pan_rad + w * (b.pan_rad - a.pan_rad),
-                  a.tilt_rad + w * (b.tilt_rad - a.tilt_rad)};
-  }
-
- private:
-  std::deque<Sample> samples_;
-  double keep_s_ = 0.2;
-};
 
 class MatchingComponent final : public runtime::Component {
  public:
@@ -93,16 +35,19 @@ class MatchingComponent final : public runtime::Component {
     keep_last_4.depth = 4;
     runtime::QosProfile keep_last_100;
     keep_last_100.depth = 100;
+    runtime::QosProfile latched;  // decode's /depth/camera_info
+    latched.durability = runtime::Durability::transient_local;
+    latched.depth = 1;
     runtime::QosProfile best_effort_2;
     best_effort_2.depth = 2;
     best_effort_2.reliability = runtime::Reliability::best_effort;
-    const PipelineConfig d;  // defaults
     return {
         .type = "matching",
         .description =
-            "model matching (paper section 6): /depth/image + /head/joint_states -> "
-            "/object/pose (camera), /object/pose_world, /object/match, /timing",
-        .parameters =
+            "model matching (paper section 6): /depth/image + /depth/camera_info + "
+            "/head/joint_states -> /object/pose (camera), /object/pose_world, /object/match, "
+            "/timing",
+        .parameters = params().specs_with(
             {ParamSpec::string("model", "ken",
                                "ken | cube | cylinder (shipped models/*.ply) or a mesh path "
                                "(PLY, STL, OBJ; metres)"),
@@ -117,58 +62,15 @@ class MatchingComponent final : public runtime::Component {
                                 "cylinder, 250 for a mesh)"),
              ParamSpec::real("scene_voxel_m", 0.0, 0.0, 1.0, "m",
                              "S-PCD voxel side r; 0 = the M-PCD's voxel side"),
-             ParamSpec::integer("outlier_neighbours", 20, 0, 1000, "",
-                                "neighbours averaged by the outlier test"),
-             ParamSpec::real("outlier_distance_m", 0.03, 0.0, 10.0, "m",
-                             "drop S-PCD points whose mean neighbour distance is larger"),
-             ParamSpec::real_list("icp_iterations", {0, 0, 1}, "",
-                                  "[n1, n2, n3] per frame on 1/4, 1/2, all scene points"),
-             ParamSpec::string("icp_model", "mpcd",
-                               "per-frame ICP model: mpcd = the M-PCD (model_points), dense = "
-                               "the 4000 dense surface samples with mesh normals (less bias)",
-                               {"mpcd", "dense"}),
-             ParamSpec::real("icp_max_distance_m", 0.03, 1e-4, 1.0, "m",
-                             "per-frame ICP: scene points farther than this from their closest "
-                             "model point are not used"),
              ParamSpec::string("icp_metric", "auto",
                                "per-frame ICP metric; auto = point_to_point for the cylinder "
                                "(point-to-plane slides along its axis), else point_to_plane",
                                {"auto", "point_to_plane", "point_to_point"}),
-             ParamSpec::real("max_rmse_m", 0.015, 0.0, 1.0, "m",
-                             "a frame fails above this ICP RMSE (0 = model's mean spacing)"),
-             ParamSpec::real("min_inlier_ratio", 0.3, 0.0, 1.0, "",
-                             "a frame fails below this inlier ratio"),
-             ParamSpec::integer("failures_before_loss", 3, 1, 100000, "",
-                                "consecutive failed frames that declare the target lost"),
-             ParamSpec::integer("min_scene_points", 15, 3, 100000, "",
-                                "fewer S-PCD points: no match (counts as a failure)"),
-             ParamSpec::integer("max_border_pixels", 20, -1, 100000, "px",
-                                "target-window pixels on the image border above which the "
-                                "target is cut off: no pose, re-initialise when whole (-1: off)"),
-             ParamSpec::boolean("constant_velocity", true,
-                                "ICP starts from the constant-velocity prediction"),
-             ParamSpec::real("lag_compensation_s", d.lag_compensation_s, 0.0, 0.1, "s",
-                             "extrapolate the published pose by this at the tracked velocity "
-                             "(docs/matching.md: measured lag and why the default)"),
-             ParamSpec::real("velocity_window_s", d.velocity_window_s, 1e-4, 1.0, "s",
-                             "span of tracked poses the velocity is estimated over"),
              ParamSpec::boolean("use_depth_info", true,
                                 "with lag_compensation_s > 0: extrapolate by the data age of "
                                 "/depth/info (same stamp as the image) instead of the fixed "
                                 "lag_compensation_s, and keep the velocity history at the "
                                 "data's time"),
-             ParamSpec::real("depth_min_m", 0.3, 0.0, 100.0, "m", "target mask: nearest depth"),
-             ParamSpec::real("depth_max_m", 1.5, 0.0, 100.0, "m", "target mask: farthest depth"),
-             ParamSpec::real("fx_px", 628.8, 1.0, 1e5, "px", "focal length along x"),
-             ParamSpec::real("fy_px", 628.8, 1.0, 1e5, "px", "focal length along y"),
-             ParamSpec::real("cx_px", 255.5, -1e4, 1e4, "px", "principal point x"),
-             ParamSpec::real("cy_px", 255.5, -1e4, 1e4, "px", "principal point y"),
-             ParamSpec::real_list("head_p_world_pan_m", {0.0, 0.0, 0.0}, "m",
-                                  "pan axis foot point in the world (geometry::HeadConfig)"),
-             ParamSpec::real_list("head_p_pan_tilt_m", {0.0, 0.0, 0.0}, "m",
-                                  "tilt axis point in the pan-rotated frame"),
-             ParamSpec::real_list("head_p_tilt_camera_m", {0.04, 0.0, 0.0}, "m",
-                                  "camera centre in the tilt-rotated frame (x = Eq. 15's a)"),
              ParamSpec::string("joint_names", "pan,tilt",
                                "names of q1 and q2 in /head/joint_states"),
              ParamSpec::real("joint_max_extrapolation_s", 0.02, 0.0, 10.0, "s",
@@ -176,7 +78,7 @@ class MatchingComponent final : public runtime::Component {
              ParamSpec::boolean("publish_scene_points", false,
                                 "publish the S-PCD on /object/scene_points (camera frame)"),
              ParamSpec::string("report_dir", "",
-                               "tests: write <name>.csv (one row per image) on deactivate")},
+                               "tests: write <name>.csv (one row per image) on deactivate")}),
         .publishes = {runtime::port<msgs::geometry_msgs::PoseStamped>("pose", "/object/pose"),
                       runtime::port<msgs::geometry_msgs::PoseStamped>("pose_world",
                                                                       "/object/pose_world"),
@@ -185,10 +87,68 @@ class MatchingComponent final : public runtime::Component {
                                                                  keep_last_100),
                       runtime::port<msgs::sensor_msgs::PointCloud2>(
                           "scene_points", "/object/scene_points", best_effort_2)},
-        .subscribes = {
-            runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
-            runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states"),
-            runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info", keep_last_4)}};
+        .subscribes =
+            {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
+             runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states"),
+             runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info", keep_last_4),
+             runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info", "/depth/camera_info",
+                                                          latched)},
+        .default_mismatches = [] { return params().default_mismatches(); }};
+  }
+
+  /// The cores' configurations behind the bound parameters (their defaults are the
+  /// parameters').
+  struct CoreConfig {
+    PipelineConfig pipeline;
+    geometry::HeadConfig head;
+  };
+
+  static const runtime::ConfigParams<CoreConfig>& params() {
+    static const auto p =
+        runtime::ConfigParams<CoreConfig>()
+            .integer("outlier_neighbours", AVS_FIELD(pipeline.scene.outlier_neighbours), 0, 1000,
+                     "", "neighbours averaged by the outlier test")
+            .real("outlier_distance_m", AVS_FIELD(pipeline.scene.outlier_mean_distance_m), 0.0,
+                  10.0, "m", "drop S-PCD points whose mean neighbour distance is larger")
+            .vector("icp_iterations", AVS_FIELD(pipeline.tracker.icp.iterations), "",
+                    "[n1, n2, n3] per frame on 1/4, 1/2, all scene points", 0.0, 1000.0)
+            .choice("icp_model", AVS_FIELD(pipeline.tracker.dense_icp_model),
+                    std::vector<std::pair<std::string, bool>>{{"mpcd", false}, {"dense", true}},
+                    "per-frame ICP model: mpcd = the M-PCD (model_points), dense = the 4000 "
+                    "dense surface samples with mesh normals (less bias)")
+            .real("icp_max_distance_m",
+                  AVS_FIELD(pipeline.tracker.icp.max_correspondence_distance_m), 1e-4, 1.0, "m",
+                  "per-frame ICP: scene points farther than this from their closest model point "
+                  "are not used")
+            .real("max_rmse_m", AVS_FIELD(pipeline.tracker.max_rmse_m), 0.0, 1.0, "m",
+                  "a frame fails above this ICP RMSE (0 = model's mean spacing)")
+            .real("min_inlier_ratio", AVS_FIELD(pipeline.tracker.min_inlier_ratio), 0.0, 1.0, "",
+                  "a frame fails below this inlier ratio")
+            .integer("failures_before_loss", AVS_FIELD(pipeline.tracker.failures_before_loss), 1,
+                     100000, "", "consecutive failed frames that declare the target lost")
+            .integer("min_scene_points", AVS_FIELD(pipeline.tracker.min_scene_points), 3, 100000,
+                     "", "fewer S-PCD points: no match (counts as a failure)")
+            .integer("max_border_pixels", AVS_FIELD(pipeline.max_border_pixels), -1, 100000, "px",
+                     "target-window pixels on the image border above which the target is cut "
+                     "off: no pose, re-initialise when whole (-1: off)")
+            .boolean("constant_velocity", AVS_FIELD(pipeline.tracker.constant_velocity),
+                     "ICP starts from the constant-velocity prediction")
+            .real("lag_compensation_s", AVS_FIELD(pipeline.lag_compensation_s), 0.0, 0.1, "s",
+                  "extrapolate the published pose by this at the tracked velocity "
+                  "(docs/matching.md: measured lag and why the default)")
+            .real("velocity_window_s", AVS_FIELD(pipeline.velocity_window_s), 1e-4, 1.0, "s",
+                  "span of tracked poses the velocity is estimated over")
+            .real("depth_min_m", AVS_FIELD(pipeline.depth_min_m), 0.0, 100.0, "m",
+                  "target mask: nearest depth")
+            .real("depth_max_m", AVS_FIELD(pipeline.depth_max_m), 0.0, 100.0, "m",
+                  "target mask: farthest depth")
+            .vector("head_p_world_pan_m", AVS_FIELD(head.p_world_pan_m), "m",
+                    "pan axis foot point in the world (geometry::HeadConfig)")
+            .vector("head_p_pan_tilt_m", AVS_FIELD(head.p_pan_tilt_m), "m",
+                    "tilt axis point in the pan-rotated frame")
+            .vector("head_p_tilt_camera_m", AVS_FIELD(head.p_tilt_camera_m), "m",
+                    "camera centre in the tilt-rotated frame (x = Eq. 15's a)");
+    return p;
   }
 
   explicit MatchingComponent(ComponentContext& ctx)
@@ -208,73 +168,46 @@ class MatchingComponent final : public runtime::Component {
     const auto model_points = ctx.param<std::int64_t>("model_points");
     model_config.target_points =
         model_points > 0 ? static_cast<std::size_t>(model_points) : object.model_points;
-    PipelineConfig config;
-    config.camera.fx_px = static_cast<float>(ctx.param<double>("fx_px"));
-    config.camera.fy_px = static_cast<float>(ctx.param<double>("fy_px"));
-    config.camera.cx_px = static_cast<float>(ctx.param<double>("cx_px"));
-    config.camera.cy_px = static_cast<float>(ctx.param<double>("cy_px"));
-    config.depth_min_m = static_cast<float>(ctx.param<double>("depth_min_m"));
-    config.depth_max_m = static_cast<float>(ctx.param<double>("depth_max_m"));
+    const CoreConfig core = params().make(ctx.parameters());
+    PipelineConfig config = core.pipeline;
     const auto scene_points = ctx.param<std::int64_t>("scene_points");
     config.scene.target_points =
         scene_points > 0 ? static_cast<std::size_t>(scene_points) : object.scene_points;
     config.scene.voxel_size_m = static_cast<float>(ctx.param<double>("scene_voxel_m"));
-    config.scene.outlier_neighbours =
-        static_cast<std::size_t>(ctx.param<std::int64_t>("outlier_neighbours"));
-    config.scene.outlier_mean_distance_m =
-        static_cast<float>(ctx.param<double>("outlier_distance_m"));
-    const auto iterations = ctx.param<std::vector<double>>("icp_iterations");
-    if (iterations.size() != 3) {
-      throw std::invalid_argument("parameter 'icp_iterations' needs 3 values [n1, n2, n3], got " +
-                                  std::to_string(iterations.size()));
-    }
-    for (std::size_t k = 0; k < 3; ++k) {
-      if (iterations[k] < 0 || iterations[k] > 1000 || iterations[k] != std::floor(iterations[k]))
-        throw std::invalid_argument("parameter 'icp_iterations': expected integers in [0, 1000]");
-      config.tracker.icp.iterations[k] = static_cast<int>(iterations[k]);
+    for (const double n : ctx.param<std::vector<double>>("icp_iterations")) {
+      if (n != std::floor(n)) {
+        throw std::invalid_argument("parameter 'icp_iterations': expected integers, got " +
+                                    std::to_string(n));
+      }
     }
     const std::string metric = ctx.param<std::string>("icp_metric");
     config.tracker.icp.metric = metric == "auto"             ? object.metric
                                 : metric == "point_to_point" ? IcpMetric::point_to_point
                                                              : IcpMetric::point_to_plane;
-    config.tracker.icp.max_correspondence_distance_m =
-        static_cast<float>(ctx.param<double>("icp_max_distance_m"));
-    config.tracker.dense_icp_model = ctx.param<std::string>("icp_model") == "dense";
-    config.tracker.max_rmse_m = static_cast<float>(ctx.param<double>("max_rmse_m"));
-    config.tracker.min_inlier_ratio = static_cast<float>(ctx.param<double>("min_inlier_ratio"));
-    config.tracker.failures_before_loss =
-        static_cast<int>(ctx.param<std::int64_t>("failures_before_loss"));
-    config.tracker.min_scene_points =
-        static_cast<std::size_t>(ctx.param<std::int64_t>("min_scene_points"));
-    config.max_border_pixels = static_cast<int>(ctx.param<std::int64_t>("max_border_pixels"));
-    config.tracker.constant_velocity = ctx.param<bool>("constant_velocity");
-    config.lag_compensation_s = ctx.param<double>("lag_compensation_s");
-    config.velocity_window_s = ctx.param<double>("velocity_window_s");
     pipeline_.emplace(make_model_cloud(object.mesh, model_config), config);
     log().info("model '", object.name, "' from ", object.mesh_path, ": ",
                pipeline_->model().points_m.size(), " M-PCD points, voxel ",
                1e3 * pipeline_->model().voxel_size_m, " mm");
 
-    head_.p_world_pan_m =
-        triple(ctx.param<std::vector<double>>("head_p_world_pan_m"), "head_p_world_pan_m");
-    head_.p_pan_tilt_m =
-        triple(ctx.param<std::vector<double>>("head_p_pan_tilt_m"), "head_p_pan_tilt_m");
-    head_.p_tilt_camera_m =
-        triple(ctx.param<std::vector<double>>("head_p_tilt_camera_m"), "head_p_tilt_camera_m");
-    const std::string names = ctx.param<std::string>("joint_names");
-    const auto comma = names.find(',');
-    if (comma == std::string::npos) {
-      throw std::invalid_argument("parameter 'joint_names' needs 'pan,tilt', got '" + names + "'");
-    }
-    joint_names_ = {names.substr(0, comma), names.substr(comma + 1)};
+    head_ = core.head;
+    const auto names =
+        msg::parse_name_list(ctx.param<std::string>("joint_names"), 2, "joint_names");
+    joint_names_ = {names[0], names[1]};
 
     ctx.subscribe<msgs::sensor_msgs::JointState>(
         "joint_states",
         [this](runtime::SamplePtr<msgs::sensor_msgs::JointState> m) { on_joints(*m); });
     ctx.subscribe<msgs::avs_msgs::DepthInfo>(
         "depth_info", [this](runtime::SamplePtr<msgs::avs_msgs::DepthInfo> m) { on_info(*m); });
+    ctx.subscribe<msgs::sensor_msgs::CameraInfo>(
+        "camera_info",
+        [this](runtime::SamplePtr<msgs::sensor_msgs::CameraInfo> m) { on_camera_info(*m); });
     ctx.subscribe<msgs::sensor_msgs::Image>(
         "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
+  }
+
+  std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
+    return {rejected_.diagnostic()};
   }
 
   void on_deactivate() override {
@@ -293,10 +226,11 @@ class MatchingComponent final : public runtime::Component {
  private:
   void on_joints(const msgs::sensor_msgs::JointState& m) {
     std::optional<double> q[2];
-    for (std::uint32_t i = 0; i < m.name._length && i < m.position._length; ++i) {
-      const std::string_view name = runtime::get_string(m.name._buffer[i]);
-      for (std::size_t axis = 0; axis < 2; ++axis) {
-        if (name == joint_names_[axis]) q[axis] = m.position._buffer[i];
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      if (const auto joint = msg::find_joint(m, joint_names_[axis])) q[axis] = joint->position;
+      if (q[axis] && !std::isfinite(*q[axis])) {
+        rejected_.reject("joint state '" + joint_names_[axis] + "' position not finite");
+        return;
       }
     }
     if (!q[0] || !q[1]) {
@@ -324,14 +258,18 @@ class MatchingComponent final : public runtime::Component {
     return std::nullopt;
   }
 
+  void on_camera_info(const msgs::sensor_msgs::CameraInfo& m) {
+    if (camera_.update(m)) pipeline_->set_camera(*camera_.model());
+  }
+
   void on_depth(const msgs::sensor_msgs::Image& image) {
     std::string why;
     const auto layout = runtime::depth_image_layout(image, &why);
     if (!layout) {
-      if (!warned_encoding_) log().error(why, ": ignored");
-      warned_encoding_ = true;
+      rejected_.reject(why);
       return;
     }
+    if (!camera_.accepts_image(layout->width, layout->height)) return;
     ++images_;
     const double stamp_s = runtime::from_ros_time(image.header.stamp).seconds();
     const DepthView depth{layout->depth_m, layout->width, layout->height,
@@ -369,7 +307,7 @@ class MatchingComponent final : public runtime::Component {
     auto msg = runtime::make_sample<msgs::geometry_msgs::PoseStamped>();
     msg->header.stamp = stamp;
     runtime::set_string(msg->header.frame_id, frame);
-    set_pose(T, msg->pose);
+    msg::to_pose(T, msg->pose);
     publisher.publish(std::move(msg));
   }
 
@@ -396,7 +334,7 @@ class MatchingComponent final : public runtime::Component {
     auto msg = runtime::make_sample<msgs::avs_msgs::MatchResult>();
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, "camera");
-    set_pose(out.T_camera_model.cast<double>(), msg->pose);
+    msg::to_pose(out.T_camera_model.cast<double>(), msg->pose);
     msg->rmse_m = out.track.icp.rmse_m;
     msg->inliers = static_cast<std::uint32_t>(out.track.icp.inliers);
     msg->scene_points = static_cast<std::uint32_t>(out.scene_points);
@@ -420,24 +358,7 @@ class MatchingComponent final : public runtime::Component {
     auto msg = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, "camera");
-    msg->height = 1;
-    msg->width = static_cast<std::uint32_t>(points.size());
-    runtime::resize_sequence(msg->fields, 3);
-    const char* names[3] = {"x", "y", "z"};
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      runtime::set_string(msg->fields._buffer[k].name, names[k]);
-      msg->fields._buffer[k].offset = 4 * k;
-      msg->fields._buffer[k].datatype = sensor_msgs_msg_dds__PointField_Constants_FLOAT32;
-      msg->fields._buffer[k].count = 1;
-    }
-    msg->is_bigendian = false;
-    msg->point_step = 12;
-    msg->row_step = 12 * msg->width;
-    msg->is_dense = true;
-    runtime::resize_sequence(msg->data, msg->row_step);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      std::memcpy(msg->data._buffer + 12 * i, points[i].data(), 12);
-    }
+    msg::write_xyz_cloud(points, *msg);
     scene_points_.publish(std::move(msg));
   }
 
@@ -471,7 +392,8 @@ class MatchingComponent final : public runtime::Component {
   double max_extrapolation_s_;
   bool use_depth_info_;
   std::deque<std::pair<double, double>> ages_;  // (stamp, data age) from /depth/info
-  bool warned_encoding_ = false;
+  runtime::SampleRejections rejected_{log(), "input"};
+  msg::CameraInput camera_{log(), rejected_};  ///< from /depth/camera_info
   bool warned_no_joints_ = false;
   bool warned_joint_names_ = false;
   std::uint64_t images_ = 0, aged_images_ = 0, poses_ = 0, world_poses_ = 0, initialisations_ = 0;

@@ -46,9 +46,12 @@ double stride_ratio(std::size_t valid_pixels, std::size_t target_points) {
 }
 
 const Points& SceneCloudBuilder::build(const DepthView& depth, const MaskView& mask,
-                                       const CameraIntrinsics& camera) {
+                                       const geometry::CameraModel& camera) {
   if (depth.depth_m == nullptr || depth.width_px <= 0 || depth.height_px <= 0) {
     throw std::invalid_argument("SceneCloudBuilder::build: empty depth image");
+  }
+  if (const std::string problem = camera.problem(); !problem.empty()) {
+    throw std::invalid_argument("SceneCloudBuilder::build: camera model: " + problem);
   }
   const int stride = depth.stride_px > 0 ? depth.stride_px : depth.width_px;
   const int mask_stride = mask.stride_px > 0 ? mask.stride_px : depth.width_px;
@@ -69,7 +72,11 @@ const Points& SceneCloudBuilder::build(const DepthView& depth, const MaskView& m
     for (int u = 0; u < depth.width_px; ++u) valid_pixels_ += valid(u, v) ? 1U : 0U;
   }
 
-  // 2. Keep the (i * C_p)-th valid pixel, i = 1, 2, ... (Eq. 27), back-projected to 3-D.
+  // 2. Keep the (i * C_p)-th valid pixel, i = 1, 2, ... (Eq. 27), back-projected to 3-D along
+  // the pixel's ray (the pinhole in float, as before distortion was supported).
+  const bool distorted = camera.has_distortion();
+  const auto fx = static_cast<float>(camera.fx_px), fy = static_cast<float>(camera.fy_px);
+  const auto cx = static_cast<float>(camera.cx_px), cy = static_cast<float>(camera.cy_px);
   const double ratio = stride_ratio(valid_pixels_, config_.target_points);
   sampled_.clear();
   std::size_t index = 0;
@@ -81,8 +88,14 @@ const Points& SceneCloudBuilder::build(const DepthView& depth, const MaskView& m
         const float z =
             depth.depth_m[static_cast<std::size_t>(v) * static_cast<std::size_t>(stride) +
                           static_cast<std::size_t>(u)];
-        sampled_.emplace_back((static_cast<float>(u) - camera.cx_px) * z / camera.fx_px,
-                              (static_cast<float>(v) - camera.cy_px) * z / camera.fy_px, z);
+        if (distorted) {
+          const Eigen::Vector3d ray = camera.ray(u, v);  // distortion removed
+          sampled_.emplace_back(static_cast<float>(ray.x()) * z, static_cast<float>(ray.y()) * z,
+                                z);
+        } else {
+          sampled_.emplace_back((static_cast<float>(u) - cx) * z / fx,
+                                (static_cast<float>(v) - cy) * z / fy, z);
+        }
         next += ratio;
       }
       ++index;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <stdexcept>
 
 namespace avs::matching {
 namespace {
@@ -110,7 +111,19 @@ std::size_t DepthImage::valid_pixels() const {
 }
 
 DepthImage render_depth(const geometry::Mesh& mesh, const Eigen::Isometry3f& T_camera_model,
-                        const CameraIntrinsics& camera) {
+                        const geometry::CameraModel& lens) {
+  if (lens.has_distortion()) {
+    throw std::invalid_argument("render_depth: pinhole only, the camera has lens distortion");
+  }
+  struct {
+    float fx_px, fy_px, cx_px, cy_px;
+    int width_px, height_px;
+  } const camera{static_cast<float>(lens.fx_px),
+                 static_cast<float>(lens.fy_px),
+                 static_cast<float>(lens.cx_px),
+                 static_cast<float>(lens.cy_px),
+                 lens.width,
+                 lens.height};
   DepthImage image;
   image.width_px = camera.width_px;
   image.height_px = camera.height_px;

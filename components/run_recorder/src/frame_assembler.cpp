@@ -13,15 +13,13 @@ namespace {
 constexpr std::int64_t kTruthToleranceNs = 100'000;
 }  // namespace
 
-bool CameraModel::in_view(const Eigen::Vector3d& p) const {
+bool in_view(const geometry::CameraModel& camera, const Eigen::Vector3d& p) {
   if (!(p.z() > 0.0)) return false;
-  const double u = fx_px * p.x() / p.z() + cx_px;
-  const double v = fy_px * p.y() / p.z() + cy_px;
-  return u >= -0.5 && u < width - 0.5 && v >= -0.5 && v < height - 0.5;
+  return camera.contains(camera.project(p));
 }
 
-FrameAssembler::FrameAssembler(CameraModel camera, RowSink sink, int settle_updates)
-    : camera_(camera), sink_(std::move(sink)), settle_updates_(settle_updates) {}
+FrameAssembler::FrameAssembler(RowSink sink, int settle_updates)
+    : sink_(std::move(sink)), settle_updates_(settle_updates) {}
 
 FrameAssembler::Pending& FrameAssembler::pending(std::int64_t stamp_ns) {
   auto [it, inserted] = pending_.try_emplace(stamp_ns);
@@ -46,9 +44,9 @@ void FrameAssembler::on_depth(std::int64_t stamp_ns) {
 void FrameAssembler::on_target(std::int64_t stamp_ns, bool valid, double u_px, double v_px) {
   if (stamp_ns <= last_emitted_ns_) return;
   report::FrameRow& row = pending(stamp_ns).row;
-  if (valid) {
+  if (valid && camera_) {
     // FrameRow wants the centroid relative to the image centre (Fig. 8's error).
-    row.centroid_px = Eigen::Vector2d(u_px - camera_.cx_px, v_px - camera_.cy_px);
+    row.centroid_px = Eigen::Vector2d(u_px - camera_->cx_px, v_px - camera_->cy_px);
   } else {
     row.centroid_px.reset();
   }
@@ -87,7 +85,7 @@ void FrameAssembler::emit(std::int64_t stamp_ns, Pending& p) {
   } else {
     report::FrameRow& row = p.row;
     row.truth = truth->second.world;
-    row.in_view = camera_.in_view(truth->second.p_camera_m);
+    row.in_view = camera_ && in_view(*camera_, truth->second.p_camera_m);
     row.pan_rad = truth->second.pan_rad;
     row.tilt_rad = truth->second.tilt_rad;
     // A pose only counts with a match state that has one.

@@ -9,6 +9,8 @@
 #include "avs/geometry/builtin_models.hpp"
 #include "avs/geometry/mesh.hpp"
 #include "avs/matching/model_cloud.hpp"
+#include "avs/msg/camera_info.hpp"
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/sample.hpp"
 #include "avs/runtime/time.hpp"
 
@@ -23,11 +25,10 @@ std::int64_t stamp_ns(const msgs::builtin_interfaces::Time& t) {
 }
 
 report::Pose to_pose(const msgs::geometry_msgs::Pose& p) {
+  const Eigen::Isometry3d T = msg::to_isometry(p);
   report::Pose out;
-  out.p_world_m = {p.position.x, p.position.y, p.position.z};
-  out.q_world =
-      Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
-          .normalized();
+  out.p_world_m = T.translation();
+  out.q_world = Eigen::Quaterniond(T.linear());
   return out;
 }
 
@@ -51,43 +52,14 @@ geometry::Mesh load_model(const std::string& model) {
   return geometry::load_mesh(model);
 }
 
-/// x, y, z (FLOAT32) of a PointCloud2; throws for a layout without them.
-std::vector<Eigen::Vector3d> cloud_points(const msgs::sensor_msgs::PointCloud2& cloud) {
-  int offset[3] = {-1, -1, -1};
-  const char* names[3] = {"x", "y", "z"};
-  for (std::uint32_t i = 0; i < cloud.fields._length; ++i) {
-    const auto& f = cloud.fields._buffer[i];
-    for (int a = 0; a < 3; ++a) {
-      if (runtime::get_string(f.name) == names[a] && f.datatype == 7 /* FLOAT32 */) {
-        offset[a] = static_cast<int>(f.offset);
-      }
-    }
-  }
-  if (offset[0] < 0 || offset[1] < 0 || offset[2] < 0 || cloud.is_bigendian) {
-    throw std::runtime_error("PointCloud2 without little-endian FLOAT32 x, y, z fields");
-  }
-  const std::size_t count = static_cast<std::size_t>(cloud.width) * cloud.height;
-  if (cloud.point_step < 12 || count * cloud.point_step > cloud.data._length) {
-    throw std::runtime_error("PointCloud2 data shorter than width x height x point_step");
-  }
-  std::vector<Eigen::Vector3d> points;
-  points.reserve(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::uint8_t* p = cloud.data._buffer + i * cloud.point_step;
-    float xyz[3];
-    for (int a = 0; a < 3; ++a) std::memcpy(&xyz[a], p + offset[a], 4);
-    if (std::isfinite(xyz[0]) && std::isfinite(xyz[1]) && std::isfinite(xyz[2])) {
-      points.emplace_back(xyz[0], xyz[1], xyz[2]);
-    }
-  }
-  return points;
-}
-
 }  // namespace
 
 runtime::ComponentSpec RunRecorderComponent::spec() {
   runtime::QosProfile deep;
   deep.depth = 100;
+  runtime::QosProfile latched;  // decode's /depth/camera_info
+  latched.durability = runtime::Durability::transient_local;
+  latched.depth = 1;
   return {
       .type = "run_recorder",
       .description =
@@ -106,12 +78,6 @@ runtime::ComponentSpec RunRecorderComponent::spec() {
            ParamSpec::string("model", "",
                              "mesh drawn over the scene in the cloud snapshots (built-in name or "
                              "file); empty: `object`"),
-           ParamSpec::real("fx_px", 628.8, 1.0, 1e5, "px", "camera focal length x (in-view test)"),
-           ParamSpec::real("fy_px", 628.8, 1.0, 1e5, "px", "camera focal length y"),
-           ParamSpec::real("cx_px", 255.5, -1e4, 1e4, "px", "principal point x"),
-           ParamSpec::real("cy_px", 255.5, -1e4, 1e4, "px", "principal point y"),
-           ParamSpec::integer("width", 512, 1, 100000, "px", "image width"),
-           ParamSpec::integer("height", 512, 1, 100000, "px", "image height"),
            ParamSpec::real("depth_snapshot_time_s", 1.0, 0.0, 1e9, "s",
                            "the first depth image at or after this time is kept (Figure 9); "
                            "a shorter run keeps its last one"),
@@ -121,6 +87,8 @@ runtime::ComponentSpec RunRecorderComponent::spec() {
       .subscribes = {
           runtime::port<msgs::avs_msgs::GroundTruth>("ground_truth", "/sim/ground_truth", deep),
           runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
+          runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info", "/depth/camera_info",
+                                                       latched),
           runtime::port<msgs::avs_msgs::TargetObservation>("target", "/target", deep),
           runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match", deep),
           runtime::port<msgs::geometry_msgs::PoseStamped>("pose_world", "/object/pose_world", deep),
@@ -140,15 +108,8 @@ RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Com
   std::filesystem::create_directories(dir);
   recorder_ = std::make_unique<report::RunRecorder>(dir, info);
 
-  CameraModel camera;
-  camera.fx_px = ctx.param<double>("fx_px");
-  camera.fy_px = ctx.param<double>("fy_px");
-  camera.cx_px = ctx.param<double>("cx_px");
-  camera.cy_px = ctx.param<double>("cy_px");
-  camera.width = ctx.param<int>("width");
-  camera.height = ctx.param<int>("height");
   assembler_ = std::make_unique<FrameAssembler>(
-      camera, [this](const report::FrameRow& row) { recorder_->write_frame(row); });
+      [this](const report::FrameRow& row) { recorder_->write_frame(row); });
   depth_snapshot_time_s_ = ctx.param<double>("depth_snapshot_time_s");
   cloud_times_s_ = ctx.param<std::vector<double>>("cloud_snapshot_times_s");
   std::sort(cloud_times_s_.begin(), cloud_times_s_.end());
@@ -183,6 +144,15 @@ RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Com
         truth.tilt_rad = m->tilt_rad;
         assembler_->on_truth(stamp_ns(m->header.stamp), truth);
         ++progress_.frames;
+      });
+  ctx.subscribe<msgs::sensor_msgs::CameraInfo>(
+      "camera_info", [this](runtime::SamplePtr<msgs::sensor_msgs::CameraInfo> m) {
+        std::string why;
+        if (const auto camera = msg::from_camera_info(*m, &why)) {
+          assembler_->set_camera(*camera);  // the in-view test and the centroid's origin
+        } else {
+          log().warn(why, ": ignored");
+        }
       });
   ctx.subscribe<msgs::sensor_msgs::Image>(
       "depth",
@@ -294,14 +264,14 @@ void RunRecorderComponent::on_scene_points(const msgs::sensor_msgs::PointCloud2&
   if (static_cast<double>(stamp) * 1e-9 < cloud_times_s_[next_cloud_]) return;
   // The model at the pose estimated from this very cloud (published before the cloud).
   if (!last_pose_camera_ || last_pose_camera_->first != stamp) return;
-  std::vector<Eigen::Vector3d> scene;
-  try {
-    scene = cloud_points(cloud);
-  } catch (const std::exception& e) {
-    log().warn("cloud snapshot skipped: ", e.what());
+  std::string why;
+  const auto points = msg::read_xyz_cloud(cloud, &why);
+  if (!points) {
+    log().warn("cloud snapshot skipped: ", why);
     next_cloud_ = cloud_times_s_.size();
     return;
   }
+  const std::vector<Eigen::Vector3d>& scene = *points;
   std::vector<Eigen::Vector3d> model;
   model.reserve(model_points_m_.size());
   for (const auto& p : model_points_m_) model.push_back(last_pose_camera_->second * p);

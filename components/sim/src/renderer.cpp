@@ -43,7 +43,7 @@ std::vector<std::int8_t> make_noise_bank(std::uint64_t seed) {
   return bank;
 }
 
-PinholeView make_view(const decode::LensModel& lens, double scale, double near_m) {
+PinholeView make_view(const geometry::CameraModel& lens, double scale, double near_m) {
   // Scaling keeps pixel centres at integers: u' = (u + 0.5) s - 0.5.
   PinholeView view;
   view.width = static_cast<int>(std::ceil(lens.width * scale));
@@ -96,9 +96,13 @@ std::uint64_t frame_noise_key(std::uint64_t frame_index) {
 
 Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   const decode::SensorGeometry& g = config_.geometry;
-  if (g.camera.has_distortion() || g.projector.has_distortion()) {
+  if (g.projector.has_distortion()) {
     throw std::invalid_argument(
-        "sim::Renderer: lens distortion is not rendered (pinhole only); set k1..k3, p1, p2 to 0");
+        "sim::Renderer: projector lens distortion is not rendered yet (camera distortion is); "
+        "set the projector's distortion to 0");
+  }
+  if (const std::string problem = g.camera.problem(); !problem.empty()) {
+    throw std::invalid_argument("sim::Renderer: camera: " + problem);
   }
   if (g.camera.width <= 0 || g.camera.height <= 0 || g.projector.width <= 0 ||
       g.projector.height <= 0) {
@@ -108,7 +112,11 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
     throw std::invalid_argument("sim::Renderer: shadow_map_scale must be in (0, 1], got " +
                                 std::to_string(config_.shadow_map_scale));
   }
-  camera_view_ = make_view(g.camera, 1.0, config_.near_clip_m);
+  // The scene is rasterised into the ideal pinhole of the camera (rasterisation needs straight
+  // lines); with lens distortion, a margin wide enough for what the distorted image sees and
+  // a remap table to the camera's pixels (see remap_).
+  const geometry::CameraModel pinhole = make_pinhole_and_remap(g.camera);
+  camera_view_ = make_view(pinhole, 1.0, config_.near_clip_m);
   projector_ = g.projector;
   shadow_view_ = make_view(g.projector, config_.shadow_map_scale, config_.near_clip_m);
   // Only the coded rows (plus a cell of margin) matter: the others are dark in both polarities.
@@ -125,23 +133,23 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   R_projector_camera_ = g.R_projector_camera.cast<float>();
   t_projector_camera_m_ = g.t_projector_camera_m.cast<float>();
   projector_centre_camera_m_ = g.projector_centre_camera_m().cast<float>();
-  ray_x_.resize(g.camera.width);
-  ray_y_.resize(g.camera.height);
-  for (int x = 0; x < g.camera.width; ++x) {
-    ray_x_[x] = static_cast<float>((x - g.camera.cx_px) / g.camera.fx_px);
+  ray_x_.resize(pinhole.width);
+  ray_y_.resize(pinhole.height);
+  for (int x = 0; x < pinhole.width; ++x) {
+    ray_x_[x] = static_cast<float>((x - pinhole.cx_px) / pinhole.fx_px);
   }
-  for (int y = 0; y < g.camera.height; ++y) {
-    ray_y_[y] = static_cast<float>((y - g.camera.cy_px) / g.camera.fy_px);
+  for (int y = 0; y < pinhole.height; ++y) {
+    ray_y_[y] = static_cast<float>((y - pinhole.cy_px) / pinhole.fy_px);
   }
-  const std::size_t pixels = static_cast<std::size_t>(g.camera.width) * g.camera.height;
-  if (pixels > kNoiseBankSize / 2) {
+  if (static_cast<std::size_t>(g.camera.width) * g.camera.height > kNoiseBankSize / 2) {
     throw std::invalid_argument("sim::Renderer: camera larger than 2^19 pixels not supported");
   }
-  row_z_.resize(g.camera.width);
-  row_u_.resize(g.camera.width);
-  row_v_.resize(g.camera.width);
-  row_qz_.resize(g.camera.width);
-  row_inv_distance_.resize(g.camera.width);
+  const std::size_t pixels = static_cast<std::size_t>(pinhole.width) * pinhole.height;
+  row_z_.resize(pinhole.width);
+  row_u_.resize(pinhole.width);
+  row_v_.resize(pinhole.width);
+  row_qz_.resize(pinhole.width);
+  row_inv_distance_.resize(pinhole.width);
   base_dn_.assign(pixels, 0.0f);
   gain_dn_.assign(pixels, 0.0f);
   gray_.assign(pixels, 0);
@@ -154,14 +162,87 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   truth_.valid = true;  // nothing in view yet
 }
 
+geometry::CameraModel Renderer::make_pinhole_and_remap(const geometry::CameraModel& camera) {
+  geometry::CameraModel pinhole = camera;
+  pinhole.set_distortion_coefficients({});
+  remap_.clear();
+  if (!camera.has_distortion()) return pinhole;
+  // Where the camera's pixels look in the ideal pinhole of the same K: their bounding box
+  // gives the margin (the border suffices for the radial and tangential terms of real lenses).
+  std::vector<Eigen::Vector2d> ideal(static_cast<std::size_t>(camera.width) * camera.height);
+  double overshoot = 0.0;
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const Eigen::Vector2d p = camera.undistort_pixel(Eigen::Vector2d(u, v));
+      if (!p.allFinite()) {
+        throw std::invalid_argument(
+            "sim::Renderer: the camera's distortion does not invert at "
+            "pixel (" +
+            std::to_string(u) + ", " + std::to_string(v) + ")");
+      }
+      ideal[static_cast<std::size_t>(v) * camera.width + u] = p;
+      overshoot = std::max(
+          {overshoot, -p.x(), p.x() - (camera.width - 1), -p.y(), p.y() - (camera.height - 1)});
+    }
+  }
+  const int margin = static_cast<int>(std::ceil(overshoot)) + 2;
+  if (margin > std::max(camera.width, camera.height)) {
+    throw std::invalid_argument(
+        "sim::Renderer: the camera's distortion sees more than twice its "
+        "pinhole field of view (margin " +
+        std::to_string(margin) + " px); not a lens this renderer supports");
+  }
+  pinhole.width += 2 * margin;
+  pinhole.height += 2 * margin;
+  pinhole.cx_px += margin;
+  pinhole.cy_px += margin;
+  // Bilinear weights of the four pinhole pixels around each camera pixel's ideal position:
+  // the lens maps the pinhole's irradiance, which the sensor then samples (noise is added
+  // per camera pixel, after the remap).
+  remap_.resize(ideal.size());
+  for (std::size_t o = 0; o < ideal.size(); ++o) {
+    const double x = ideal[o].x() + margin, y = ideal[o].y() + margin;
+    const int x0 = std::clamp(static_cast<int>(std::floor(x)), 0, pinhole.width - 2);
+    const int y0 = std::clamp(static_cast<int>(std::floor(y)), 0, pinhole.height - 2);
+    const auto ax = static_cast<float>(std::clamp(x - x0, 0.0, 1.0));
+    const auto ay = static_cast<float>(std::clamp(y - y0, 0.0, 1.0));
+    RemapEntry& e = remap_[o];
+    e.index[0] = static_cast<std::uint32_t>(y0 * pinhole.width + x0);
+    e.index[1] = e.index[0] + 1;
+    e.index[2] = e.index[0] + static_cast<std::uint32_t>(pinhole.width);
+    e.index[3] = e.index[2] + 1;
+    e.weight[0] = (1 - ax) * (1 - ay);
+    e.weight[1] = ax * (1 - ay);
+    e.weight[2] = (1 - ax) * ay;
+    e.weight[3] = ax * ay;
+    e.nearest = e.index[(ay >= 0.5f ? 2 : 0) + (ax >= 0.5f ? 1 : 0)];
+  }
+  return pinhole;
+}
+
 const Renderer::Truth& Renderer::truth() const {
   if (!truth_.valid) {
     // Same computation as set_view()'s, with the ground-truth arrays written too.
     auto* self = const_cast<Renderer*>(this);
     for (int y = 0; y < camera_view_.height; ++y) self->compute_row<true>(y, &self->truth_);
     truth_.valid = true;
+    if (!remap_.empty()) {
+      // Per camera pixel, the pinhole pixel nearest to where it looks.
+      const std::size_t n = remap_.size();
+      truth_camera_.depth_m.resize(n);
+      truth_camera_.projector_row.resize(n);
+      truth_camera_.object_index.resize(n);
+      truth_camera_.code.resize(n);
+      for (std::size_t o = 0; o < n; ++o) {
+        const std::uint32_t j = remap_[o].nearest;
+        truth_camera_.depth_m[o] = truth_.depth_m[j];
+        truth_camera_.projector_row[o] = truth_.projector_row[j];
+        truth_camera_.object_index[o] = truth_.object_index[j];
+        truth_camera_.code[o] = truth_.code[j];
+      }
+    }
   }
-  return truth_;
+  return remap_.empty() ? truth_ : truth_camera_;
 }
 
 namespace {
@@ -439,17 +520,27 @@ void Renderer::compute_row(int y, Truth* truth) {
 
 template <typename ValueFn>
 void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) const {
-  out.width = camera_view_.width;
-  out.height = camera_view_.height;
-  const std::size_t n = base_dn_.size();
+  out.width = width();
+  out.height = height();
+  const std::size_t n = static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height);
   out.pixels.resize(n);
   const std::size_t offset =
       splitmix64(config_.noise_seed ^ noise_key) % (noise_bank_.size() - n + 1);
   const std::int8_t* noise = noise_bank_.data() + offset;
   const float sigma = static_cast<float>(config_.noise_sigma_dn) / kNoiseBankScale;
   std::uint8_t* pixels = out.pixels.data();
-  for (std::size_t i = 0; i < n; ++i) {
-    const float v = value(i) + sigma * static_cast<float>(noise[i]) + 0.5f;
+  if (remap_.empty()) {
+    for (std::size_t i = 0; i < n; ++i) {
+      const float v = value(i) + sigma * static_cast<float>(noise[i]) + 0.5f;
+      pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), kFullScaleDn));
+    }
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) {  // lens distortion: the pinhole's light, remapped
+    const RemapEntry& e = remap_[i];
+    const float light = e.weight[0] * value(e.index[0]) + e.weight[1] * value(e.index[1]) +
+                        e.weight[2] * value(e.index[2]) + e.weight[3] * value(e.index[3]);
+    const float v = light + sigma * static_cast<float>(noise[i]) + 0.5f;
     pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), kFullScaleDn));
   }
 }

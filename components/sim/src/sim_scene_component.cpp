@@ -15,7 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "avs/decode/calibration_yaml.hpp"
 #include "avs/geometry/builtin_models.hpp"
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/sim/scene_yaml.hpp"
 #include "avs/sim/simulator.hpp"
@@ -98,17 +100,6 @@ double median(std::vector<double> v) {
   return *mid;
 }
 
-void to_pose(const Eigen::Isometry3d& T, msgs::geometry_msgs::Pose& pose) {
-  pose.position.x = T.translation().x();
-  pose.position.y = T.translation().y();
-  pose.position.z = T.translation().z();
-  const Eigen::Quaterniond q(T.linear());
-  pose.orientation.x = q.x();
-  pose.orientation.y = q.y();
-  pose.orientation.z = q.z();
-  pose.orientation.w = q.w();
-}
-
 }  // namespace
 
 class SimScene final : public runtime::Component {
@@ -162,7 +153,11 @@ class SimScene final : public runtime::Component {
              ParamSpec::real("initial_pan_rad", 0.0, -3.2, 3.2, "rad",
                              "head pan until the first /sim/head_state (servo convention)"),
              ParamSpec::real("initial_tilt_rad", 0.0, -1.6, 1.6, "rad",
-                             "head tilt until the first /sim/head_state")},
+                             "head tilt until the first /sim/head_state"),
+             ParamSpec::string("calibration_file", "",
+                               "sensor geometry YAML the renderer uses (decode's format, "
+                               "docs/decode.md; camera distortion rendered); empty: the "
+                               "paper's sensor, default_sensor_geometry()")},
         .publishes =
             {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern", keep_last_4),
              runtime::port<msgs::avs_msgs::GroundTruth>("ground_truth", "/sim/ground_truth"),
@@ -278,6 +273,10 @@ class SimScene final : public runtime::Component {
       c.motion_blur_samples = static_cast<int>(n);
     }
     if (const double rate = ctx.param<double>("frame_rate_hz"); rate > 0) c.frame_rate_hz = rate;
+    if (const auto calibration = ctx.param<std::string>("calibration_file"); !calibration.empty()) {
+      c.renderer.geometry = decode::load_sensor_geometry_yaml(calibration);
+      log().info("sensor geometry from ", calibration);
+    }
     return file;
   }
 
@@ -377,8 +376,8 @@ class SimScene final : public runtime::Component {
       runtime::to_ros_time(stamp, m->header.stamp);
       runtime::set_string(m->header.frame_id, "world");
       runtime::set_string(m->object_name, o.name);
-      to_pose(o.T_world_object, m->pose_world);
-      to_pose(o.T_camera_object, m->pose_camera);
+      msg::to_pose(o.T_world_object, m->pose_world);
+      msg::to_pose(o.T_camera_object, m->pose_camera);
       m->pan_rad = frame.truth.head.pan_rad;
       m->tilt_rad = frame.truth.head.tilt_rad;
       m->pan_velocity_rad_s = frame.truth.head.pan_rate_rad_s;

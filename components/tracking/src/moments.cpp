@@ -5,7 +5,7 @@
 
 namespace avs::tracking {
 
-TargetObservation measure_target(const DepthImageView& depth, const CameraIntrinsics& camera,
+TargetObservation measure_target(const DepthImageView& depth, const geometry::CameraModel& camera,
                                  const MomentsConfig& config) {
   if (depth.depth_m == nullptr && depth.width * depth.height != 0) {
     throw std::invalid_argument("measure_target: null depth image of " +
@@ -44,6 +44,11 @@ TargetObservation measure_target(const DepthImageView& depth, const CameraIntrin
     obs.m_g_px = {m10 / m00, m01 / m00};  // Eq. 9
     obs.centroid_u_px = obs.m_g_px.x() + camera.cx_px;
     obs.centroid_v_px = obs.m_g_px.y() + camera.cy_px;
+    if (camera.has_distortion()) {
+      // Eq. 10 relates m_g to the target's direction through the pinhole: undistort it.
+      const Eigen::Vector2d ideal = camera.undistort_pixel({obs.centroid_u_px, obs.centroid_v_px});
+      obs.m_g_px = ideal - Eigen::Vector2d(camera.cx_px, camera.cy_px);
+    }
     obs.mean_depth_m = depth_sum / m00;
   }
   obs.present = m00 > 0 && m00 >= config.min_area_px;

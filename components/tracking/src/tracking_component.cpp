@@ -3,14 +3,20 @@
 // phi_l < h_c < phi_h (Eqs. 7-9) -> /target; the tracker's states around the servo law
 // tau = Kp J^-1 (m_d - m_g) - Kv q' (Eq. 16, image Jacobian of Eq. 15, full or simplified)
 // with the latest /head/joint_states -> /head/torque_command. `enabled: false` is the paper's
-// "no tracking" run: the head holds its pose (joint PD) whatever the image shows.
+// "no tracking" run: the head holds its pose (joint PD) whatever the image shows. The camera
+// model (focal lengths, principal point, distortion) comes from /depth/camera_info, the decoder's
+// calibration in force: tracking keeps none of its own.
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 
+#include "avs/msg/camera_input.hpp"
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/config_params.hpp"
 #include "avs/runtime/depth_image.hpp"
+#include "avs/runtime/rejections.hpp"
 #include "avs/tracking/tracker.hpp"
 
 namespace avs::tracking {
@@ -19,81 +25,86 @@ using runtime::ComponentContext;
 using runtime::ComponentSpec;
 using runtime::ParamSpec;
 
-namespace {
-
-Eigen::Vector2d pair(const std::vector<double>& v, const std::string& name) {
-  if (v.size() != 2) {
-    throw std::invalid_argument("parameter '" + name + "' needs 2 values (pan, tilt), got " +
-                                std::to_string(v.size()));
-  }
-  return {v[0], v[1]};
-}
-
-}  // namespace
-
 class TrackingComponent final : public runtime::Component {
  public:
-  /// Camera defaults: the paper's sensor as avs::decode::default_sensor_geometry() models it
-  /// (512 x 512, f = 256 / tan(22.15 deg) = 628.8 px, principal point at the centre).
-  static constexpr double default_f_px = 628.8;
-  static constexpr double default_c_px = 255.5;
-
   static ComponentSpec spec() {
     runtime::QosProfile keep_last_1;
     keep_last_1.depth = 1;
+    runtime::QosProfile latched;  // decode's /depth/camera_info
+    latched.durability = runtime::Durability::transient_local;
+    latched.depth = 1;
     runtime::QosProfile keep_last_4;
     keep_last_4.depth = 4;
     return {
         .type = "tracking",
         .description =
             "target moments from the depth window (Eqs. 7-9) and the visual servo "
-            "law (Eqs. 15-16): /depth/image + /head/joint_states -> /target, "
-            "/head/torque_command",
-        .parameters =
+            "law (Eqs. 15-16): /depth/image + /depth/camera_info + /head/joint_states -> "
+            "/target, /head/torque_command",
+        .parameters = params().specs_with(
             {ParamSpec::boolean("enabled", true,
                                 "false: never track, hold the head's pose (the no-tracking run)"),
-             ParamSpec::real("fx_px", default_f_px, 1.0, 1e5, "px", "focal length along x"),
-             ParamSpec::real("fy_px", default_f_px, 1.0, 1e5, "px", "focal length along y"),
-             ParamSpec::real("cx_px", default_c_px, -1e4, 1e4, "px", "principal point x"),
-             ParamSpec::real("cy_px", default_c_px, -1e4, 1e4, "px", "principal point y"),
-             ParamSpec::real("depth_min_m", 0.3, 0.0, 100.0, "m", "phi_l of Eq. 8"),
-             ParamSpec::real("depth_max_m", 1.5, 0.0, 100.0, "m", "phi_h of Eq. 8"),
-             ParamSpec::real("min_area_px", 50.0, 1.0, 1e7, "px", "m00 below this: no target"),
-             ParamSpec::string("jacobian", "simplified", "image Jacobian of Eq. 15",
-                               {"full", "simplified"}),
-             ParamSpec::real("a_m", 0.0, -1.0, 1.0, "m",
-                             "Figure 3: tilt axis to camera centre along X_c (full Jacobian)"),
-             ParamSpec::real_list("kp_nm_per_rad", {12.0, 2.0}, "N m/rad",
-                                  "K_p (pan, tilt); tuned on servo_tracking_loop.yaml"),
-             ParamSpec::real_list("kv_nm_s_per_rad", {0.3, 0.05}, "N m s/rad",
-                                  "K_v (pan, tilt); tuned on servo_tracking_loop.yaml"),
-             ParamSpec::real_list("m_d_px", {0.0, 0.0}, "px",
-                                  "desired image position relative to the principal point"),
-             ParamSpec::real_list("max_torque_nm", {5.73, 0.9555}, "N m",
-                                  "motor torque limit per axis (Table 3)"),
-             ParamSpec::real("min_cos_q2", 0.1, 0.001, 1.0, "",
-                             "|cos q2| floor that keeps J invertible"),
-             ParamSpec::integer("frames_to_track", 3, 1, 100000, "",
-                                "consecutive frames with a target before tracking"),
-             ParamSpec::integer("frames_to_idle", 100, 0, 10000000, "",
-                                "frames without target in 'lost' before 'idle'"),
-             ParamSpec::string("idle", "hold", "idle behaviour", {"hold", "return_home"}),
-             ParamSpec::real_list("home_q_rad", {0.0, 0.0}, "rad", "home pose (return_home)"),
-             ParamSpec::real_list("hold_kp_nm_per_rad", {2.0, 0.3}, "N m/rad",
-                                  "joint PD for hold / home"),
-             ParamSpec::real_list("hold_kv_nm_s_per_rad", {0.1, 0.015}, "N m s/rad",
-                                  "joint PD for hold / home"),
              ParamSpec::string("joint_names", "pan,tilt",
                                "names of q1 and q2 in /head/joint_states and the command"),
              ParamSpec::string("report_dir", "",
-                               "tests: write <name>.csv (one row per image) on deactivate")},
+                               "tests: write <name>.csv (one row per image) on deactivate")}),
         .publishes = {runtime::port<msgs::avs_msgs::TargetObservation>("target", "/target"),
                       runtime::port<msgs::avs_msgs::JointTorqueCommand>(
                           "torque_command", "/head/torque_command", keep_last_1),
                       runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing")},
-        .subscribes = {
-            runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
-            runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states")}};
+        .subscribes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image",
+                                                               keep_last_4),
+                       runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
+                                                                    "/depth/camera_info", latched),
+                       runtime::port<msgs::sensor_msgs::JointState>("joint_states",
+                                                                    "/head/joint_states")},
+        .default_mismatches = [] { return params().default_mismatches(); }};
+  }
+
+  /// The cores' configurations behind the parameters (their defaults are the parameters').
+  struct CoreConfig {
+    TrackerConfig tracker;
+    MomentsConfig moments;
+  };
+
+  /// Parameters bound to the core configs (Eqs. 8, 15, 16 and the tracking states).
+  static const runtime::ConfigParams<CoreConfig>& params() {
+    static const auto p =
+        runtime::ConfigParams<CoreConfig>()
+            .real("depth_min_m", AVS_FIELD(moments.depth_min_m), 0.0, 100.0, "m", "phi_l of Eq. 8")
+            .real("depth_max_m", AVS_FIELD(moments.depth_max_m), 0.0, 100.0, "m", "phi_h of Eq. 8")
+            .real("min_area_px", AVS_FIELD(moments.min_area_px), 1.0, 1e7, "px",
+                  "m00 below this: no target")
+            .choice("jacobian", AVS_FIELD(tracker.law.jacobian),
+                    std::vector<std::pair<std::string, JacobianForm>>{
+                        {"full", JacobianForm::full}, {"simplified", JacobianForm::simplified}},
+                    "image Jacobian of Eq. 15")
+            .real("a_m", AVS_FIELD(tracker.law.a_m), -1.0, 1.0, "m",
+                  "Figure 3: tilt axis to camera centre along X_c (full Jacobian)")
+            .vector("kp_nm_per_rad", AVS_FIELD(tracker.law.kp_nm_per_rad), "N m/rad",
+                    "K_p (pan, tilt); tuned on servo_tracking_loop.yaml")
+            .vector("kv_nm_s_per_rad", AVS_FIELD(tracker.law.kv_nm_s_per_rad), "N m s/rad",
+                    "K_v (pan, tilt); tuned on servo_tracking_loop.yaml")
+            .vector("m_d_px", AVS_FIELD(tracker.law.m_d_px), "px",
+                    "desired image position relative to the principal point")
+            .vector("max_torque_nm", AVS_FIELD(tracker.law.max_torque_nm), "N m",
+                    "motor torque limit per axis (Table 3)")
+            .real("min_cos_q2", AVS_FIELD(tracker.law.min_cos_q2), 0.001, 1.0, "",
+                  "|cos q2| floor that keeps J invertible")
+            .integer("frames_to_track", AVS_FIELD(tracker.frames_to_track), 1, 100000, "",
+                     "consecutive frames with a target before tracking")
+            .integer("frames_to_idle", AVS_FIELD(tracker.frames_to_idle), 0, 10000000, "",
+                     "frames without target in 'lost' before 'idle'")
+            .choice("idle", AVS_FIELD(tracker.idle),
+                    std::vector<std::pair<std::string, IdleBehaviour>>{
+                        {"hold", IdleBehaviour::hold}, {"return_home", IdleBehaviour::return_home}},
+                    "idle behaviour")
+            .vector("home_q_rad", AVS_FIELD(tracker.home_q_rad), "rad", "home pose (return_home)")
+            .vector("hold_kp_nm_per_rad", AVS_FIELD(tracker.hold_kp_nm_per_rad), "N m/rad",
+                    "joint PD for hold / home")
+            .vector("hold_kv_nm_s_per_rad", AVS_FIELD(tracker.hold_kv_nm_s_per_rad), "N m s/rad",
+                    "joint PD for hold / home");
+    return p;
   }
 
   explicit TrackingComponent(ComponentContext& ctx)
@@ -101,26 +112,30 @@ class TrackingComponent final : public runtime::Component {
         target_(ctx.publisher<msgs::avs_msgs::TargetObservation>("target")),
         command_(ctx.publisher<msgs::avs_msgs::JointTorqueCommand>("torque_command")),
         timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
-        tracker_(make_config(ctx)),
+        core_(params().make(ctx.parameters())),
+        tracker_(core_.tracker),
         enabled_(ctx.param<bool>("enabled")),
-        report_dir_(ctx.param<std::string>("report_dir")) {
-    camera_ = {ctx.param<double>("fx_px"), ctx.param<double>("fy_px"), ctx.param<double>("cx_px"),
-               ctx.param<double>("cy_px")};
-    moments_.depth_min_m = ctx.param<double>("depth_min_m");
-    moments_.depth_max_m = ctx.param<double>("depth_max_m");
-    moments_.min_area_px = ctx.param<double>("min_area_px");
+        report_dir_(ctx.param<std::string>("report_dir")),
+        rejected_(ctx.log(), "input") {
+    moments_ = core_.moments;
     if (!(moments_.depth_min_m < moments_.depth_max_m)) {
       throw std::invalid_argument("depth_min_m must be below depth_max_m");
     }
-    const std::string names = ctx.param<std::string>("joint_names");
-    const auto comma = names.find(',');
-    if (comma == std::string::npos) throw std::invalid_argument("joint_names needs 'pan,tilt'");
-    joint_names_ = {names.substr(0, comma), names.substr(comma + 1)};
+    const auto names =
+        msg::parse_name_list(ctx.param<std::string>("joint_names"), 2, "joint_names");
+    joint_names_ = {names[0], names[1]};
     ctx.subscribe<msgs::sensor_msgs::JointState>(
         "joint_states",
         [this](runtime::SamplePtr<msgs::sensor_msgs::JointState> m) { on_joints(*m); });
+    ctx.subscribe<msgs::sensor_msgs::CameraInfo>(
+        "camera_info",
+        [this](runtime::SamplePtr<msgs::sensor_msgs::CameraInfo> m) { on_camera_info(*m); });
     ctx.subscribe<msgs::sensor_msgs::Image>(
         "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
+  }
+
+  std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
+    return {rejected_.diagnostic()};
   }
 
   void on_deactivate() override {
@@ -136,51 +151,38 @@ class TrackingComponent final : public runtime::Component {
   }
 
  private:
-  static TrackerConfig make_config(ComponentContext& ctx) {
-    TrackerConfig c;
-    c.law.jacobian = ctx.param<std::string>("jacobian") == "full" ? JacobianForm::full
-                                                                  : JacobianForm::simplified;
-    c.law.fx_px = ctx.param<double>("fx_px");
-    c.law.fy_px = ctx.param<double>("fy_px");
-    c.law.a_m = ctx.param<double>("a_m");
-    c.law.kp_nm_per_rad = pair(ctx.param<std::vector<double>>("kp_nm_per_rad"), "kp_nm_per_rad");
-    c.law.kv_nm_s_per_rad =
-        pair(ctx.param<std::vector<double>>("kv_nm_s_per_rad"), "kv_nm_s_per_rad");
-    c.law.m_d_px = pair(ctx.param<std::vector<double>>("m_d_px"), "m_d_px");
-    c.law.max_torque_nm = pair(ctx.param<std::vector<double>>("max_torque_nm"), "max_torque_nm");
-    c.law.min_cos_q2 = ctx.param<double>("min_cos_q2");
-    c.frames_to_track = ctx.param<int>("frames_to_track");
-    c.frames_to_idle = ctx.param<int>("frames_to_idle");
-    c.idle = ctx.param<std::string>("idle") == "return_home" ? IdleBehaviour::return_home
-                                                             : IdleBehaviour::hold;
-    c.home_q_rad = pair(ctx.param<std::vector<double>>("home_q_rad"), "home_q_rad");
-    c.hold_kp_nm_per_rad =
-        pair(ctx.param<std::vector<double>>("hold_kp_nm_per_rad"), "hold_kp_nm_per_rad");
-    c.hold_kv_nm_s_per_rad =
-        pair(ctx.param<std::vector<double>>("hold_kv_nm_s_per_rad"), "hold_kv_nm_s_per_rad");
-    return c;
+  void on_joints(const msgs::sensor_msgs::JointState& m) {
+    for (int axis = 0; axis < 2; ++axis) {
+      const std::string& name = joint_names_[static_cast<std::size_t>(axis)];
+      const auto joint = msg::find_joint(m, name);
+      if (!joint) continue;
+      if (!std::isfinite(joint->position) || !std::isfinite(joint->velocity)) {
+        // A NaN here would become a NaN torque command: keep the previous joint state.
+        rejected_.reject("joint state '" + name + "' not finite (position " +
+                         std::to_string(joint->position) + ", velocity " +
+                         std::to_string(joint->velocity) + ")");
+        continue;
+      }
+      joints_.q_rad[axis] = joint->position;
+      joints_.qd_rad_s[axis] = joint->velocity;
+      have_axis_[axis] = true;
+    }
   }
 
-  void on_joints(const msgs::sensor_msgs::JointState& m) {
-    for (std::uint32_t i = 0; i < m.name._length && i < m.position._length; ++i) {
-      const std::string_view name = runtime::get_string(m.name._buffer[i]);
-      for (int axis = 0; axis < 2; ++axis) {
-        if (name != joint_names_[static_cast<std::size_t>(axis)]) continue;
-        joints_.q_rad[axis] = m.position._buffer[i];
-        joints_.qd_rad_s[axis] = i < m.velocity._length ? m.velocity._buffer[i] : 0.0;
-        have_axis_[axis] = true;
-      }
-    }
+  void on_camera_info(const msgs::sensor_msgs::CameraInfo& m) {
+    if (!camera_.update(m)) return;
+    const geometry::CameraModel& c = *camera_.model();
+    tracker_.set_focal_lengths_px(c.fx_px, c.fy_px);  // Eq. 15's f
   }
 
   void on_depth(const msgs::sensor_msgs::Image& image) {
     std::string why;
     const auto layout = runtime::depth_image_layout(image, &why);
     if (!layout) {
-      if (!warned_encoding_) log().error(why, ": ignored");
-      warned_encoding_ = true;
+      rejected_.reject(why);
       return;
     }
+    if (!camera_.accepts_image(layout->width, layout->height)) return;
     ++images_;
     const auto started = std::chrono::steady_clock::now();
     DepthImageView view;
@@ -188,7 +190,7 @@ class TrackingComponent final : public runtime::Component {
     view.width = layout->width;
     view.height = layout->height;
     view.row_stride_floats = static_cast<std::size_t>(layout->row_stride_floats);
-    TargetObservation obs = measure_target(view, camera_, moments_);  // Eqs. 7-9
+    TargetObservation obs = measure_target(view, *camera_.model(), moments_);  // Eqs. 7-9
     if (obs.present) ++frames_with_target_;
     publish_target(image, obs);
 
@@ -259,15 +261,16 @@ class TrackingComponent final : public runtime::Component {
   runtime::Publisher<msgs::avs_msgs::TargetObservation> target_;
   runtime::Publisher<msgs::avs_msgs::JointTorqueCommand> command_;
   runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
+  CoreConfig core_;
   Tracker tracker_;
   bool enabled_;
   std::string report_dir_;
-  CameraIntrinsics camera_;
+  runtime::SampleRejections rejected_;
+  msg::CameraInput camera_{log(), rejected_};  ///< from /depth/camera_info
   MomentsConfig moments_;
   std::array<std::string, 2> joint_names_;
   JointState joints_;
   bool have_axis_[2] = {false, false};
-  bool warned_encoding_ = false;
   bool warned_no_joints_ = false;
   std::uint64_t images_ = 0;
   std::uint64_t frames_with_target_ = 0;

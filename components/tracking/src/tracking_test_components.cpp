@@ -3,12 +3,15 @@
 // laterally in front of the head, seen through the TRUE head angles from /sim/head_state.
 // Head kinematics (docs/servo.md section 1): camera at the rotation centre (a = 0), optical
 // axis +z at q = 0, x right, y down; R_world_camera = Ry(q1) Rx(-q2), so positive pan turns the
-// axis toward image +x and positive tilt toward image +y, as Eq. 15's Jacobian assumes.
+// axis toward image +x and positive tilt toward image +y, as Eq. 15's Jacobian assumes. Like
+// decode it publishes the camera model on /depth/camera_info: the paper's default camera.
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Geometry>
 
+#include "avs/decode/sensor_geometry.hpp"
+#include "avs/msg/camera_info.hpp"
 #include "avs/runtime/component.hpp"
 
 namespace avs::tracking {
@@ -22,6 +25,9 @@ class TestDepthTarget final : public runtime::Component {
   static ComponentSpec spec() {
     runtime::QosProfile keep_last_4;
     keep_last_4.depth = 4;
+    runtime::QosProfile latched;
+    latched.durability = runtime::Durability::transient_local;
+    latched.depth = 1;
     return {
         .type = "test_depth_target",
         .description =
@@ -29,19 +35,15 @@ class TestDepthTarget final : public runtime::Component {
             "in front of the simulated head, through the true head angles",
         .parameters =
             {ParamSpec::real("rate_hz", 500.0, 1.0, 10000.0, "Hz", "image rate"),
-             ParamSpec::integer("width", 512, 8, 4096, "px", "image width"),
-             ParamSpec::integer("height", 512, 8, 4096, "px", "image height"),
-             ParamSpec::real("f_px", 628.8, 1.0, 1e5, "px", "focal length (square pixels)"),
-             ParamSpec::real("cx_px", 255.5, -1e4, 1e4, "px", "principal point x"),
-             ParamSpec::real("cy_px", 255.5, -1e4, 1e4, "px", "principal point y"),
              ParamSpec::real("distance_m", 1.0, 0.1, 100.0, "m", "sphere centre's z"),
              ParamSpec::real("radius_m", 0.05, 0.001, 10.0, "m", "sphere radius"),
              ParamSpec::real("amplitude_m", 0.5, 0.0, 100.0, "m", "lateral swing amplitude A"),
              ParamSpec::real("peak_speed_m_s", 1.0, 0.0, 100.0, "m/s", "peak lateral speed v"),
              ParamSpec::real("height_m", 0.0, -100.0, 100.0, "m", "sphere centre's y (image down)"),
              ParamSpec::real("start_s", 0.2, 0.0, std::nullopt, "s", "swing starts")},
-        .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image",
-                                                              keep_last_4)},
+        .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
+                      runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
+                                                                   "/depth/camera_info", latched)},
         .subscribes = {
             runtime::port<msgs::sensor_msgs::JointState>("head_state", "/sim/head_state")}};
   }
@@ -49,12 +51,13 @@ class TestDepthTarget final : public runtime::Component {
   explicit TestDepthTarget(ComponentContext& ctx)
       : Component(ctx),
         depth_(ctx.publisher<msgs::sensor_msgs::Image>("depth")),
+        camera_info_(ctx.publisher<msgs::sensor_msgs::CameraInfo>("camera_info")),
         period_(static_cast<std::int64_t>(std::llround(1e9 / ctx.param<double>("rate_hz")))),
-        width_(ctx.param<int>("width")),
-        height_(ctx.param<int>("height")),
-        f_(ctx.param<double>("f_px")),
-        cx_(ctx.param<double>("cx_px")),
-        cy_(ctx.param<double>("cy_px")),
+        width_(camera_.width),
+        height_(camera_.height),
+        f_(camera_.fx_px),
+        cx_(camera_.cx_px),
+        cy_(camera_.cy_px),
         distance_(ctx.param<double>("distance_m")),
         radius_(ctx.param<double>("radius_m")),
         amplitude_(ctx.param<double>("amplitude_m")),
@@ -68,6 +71,10 @@ class TestDepthTarget final : public runtime::Component {
   }
 
   void on_activate() override {
+    auto info = runtime::make_sample<msgs::sensor_msgs::CameraInfo>();
+    msg::to_camera_info(camera_, *info);
+    runtime::set_string(info->header.frame_id, "camera");
+    camera_info_.publish(std::move(info));
     context().create_timer(period_, [this] { render(); });
   }
 
@@ -119,7 +126,9 @@ class TestDepthTarget final : public runtime::Component {
     depth_.publish(std::move(image));
   }
 
+  const geometry::CameraModel camera_ = decode::default_sensor_geometry().camera;
   runtime::Publisher<msgs::sensor_msgs::Image> depth_;
+  runtime::Publisher<msgs::sensor_msgs::CameraInfo> camera_info_;
   runtime::Duration period_;
   int width_;
   int height_;

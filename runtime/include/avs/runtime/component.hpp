@@ -42,6 +42,10 @@ struct ComponentSpec {
   std::vector<ParamSpec> parameters;
   std::vector<PortSpec> publishes;
   std::vector<PortSpec> subscribes;
+  /// For components whose parameters are bound to a core Config (config_params.hpp): the
+  /// parameters whose spec default does not reproduce the Config's default (tests walk the
+  /// registry with it). Empty function: the component has no bound core Config.
+  std::function<std::vector<std::string>()> default_mismatches = {};
 
   const ParamSpec* find_parameter(std::string_view name) const;
   const PortSpec* find_port(std::string_view name) const;

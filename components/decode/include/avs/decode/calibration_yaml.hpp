@@ -1,7 +1,7 @@
 // Calibration file adapter (yaml-cpp): SensorGeometry <-> YAML. Kept out of avs_decode_core.
 //
 //   camera:    {width: 512, height: 512, fx: 628.8, fy: 628.8, cx: 255.5, cy: 255.5,
-//               distortion: [k1, k2, p1, p2, k3]}
+//               distortion: [k1, k2, p1, p2, k3]}   # or 8: ..., k4, k5, k6 (rational)
 //   projector: {width: 912, height: 1140, fx: 1094.4, ...same keys...}
 //   R_projector_camera: [r00, r01, r02, r10, ..., r22]   # row-major, p_proj = R p_cam + t
 //   t_projector_camera_m: [x, y, z]

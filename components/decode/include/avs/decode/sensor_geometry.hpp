@@ -1,42 +1,21 @@
 // Sensor geometry shared by the decoder and the simulator: camera and projector lens models
-// (pinhole + Brown-Conrady distortion, OpenCV order k1 k2 p1 p2 k3), the projector's pose
+// (geometry::CameraModel, the project's one camera type), the projector's pose
 // relative to the camera, the code layout, and the 3x4 matrices C and P of Eq. 4.
 #pragma once
 
 #include <Eigen/Core>
 
 #include "avs/decode/gray_code.hpp"
+#include "avs/geometry/camera_model.hpp"
 
 namespace avs::decode {
-
-/// Pinhole intrinsics plus lens distortion. Pixel centres are at integer coordinates
-/// (OpenCV convention): the image spans [-0.5, width - 0.5] x [-0.5, height - 0.5].
-struct LensModel {
-  int width = 0;   ///< pixels
-  int height = 0;  ///< pixels
-  double fx_px = 0, fy_px = 0, cx_px = 0, cy_px = 0;
-  double k1 = 0, k2 = 0, p1 = 0, p2 = 0, k3 = 0;
-
-  Eigen::Matrix3d intrinsic_matrix() const;
-  bool has_distortion() const { return k1 != 0 || k2 != 0 || p1 != 0 || p2 != 0 || k3 != 0; }
-
-  /// Ideal normalised coordinates (x/z, y/z) -> distorted normalised coordinates.
-  Eigen::Vector2d distort(const Eigen::Vector2d& xy_ideal) const;
-  /// Inverse of distort(), iteratively (converges for the moderate distortion of real lenses).
-  Eigen::Vector2d undistort(const Eigen::Vector2d& xy_distorted) const;
-
-  /// Point in this device's frame (metres, z forward) -> pixel, with distortion.
-  Eigen::Vector2d project(const Eigen::Vector3d& p_device) const;
-  /// Pixel (u, v) -> ray direction (x, y, 1) in this device's frame, distortion removed.
-  Eigen::Vector3d ray(double u_px, double v_px) const;
-};
 
 /// Everything the decoder needs to turn a code into depth. Frames: the camera frame is the
 /// reference (x right, y down, z forward); p_projector = R_projector_camera * p_camera +
 /// t_projector_camera_m (the OpenCV stereoCalibrate convention).
 struct SensorGeometry {
-  LensModel camera;
-  LensModel projector;
+  geometry::CameraModel camera;
+  geometry::CameraModel projector;
   Eigen::Matrix3d R_projector_camera = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t_projector_camera_m = Eigen::Vector3d::Zero();
   CodeLayout layout;

@@ -7,20 +7,12 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "avs/geometry/camera_model.hpp"
+
 namespace avs::matching {
 
 /// A point cloud: positions in metres, in the frame named by the variable (p_camera, p_model).
 using Points = std::vector<Eigen::Vector3f>;
-
-/// Pinhole intrinsics of the depth camera (pixels); the camera looks along +z.
-struct CameraIntrinsics {
-  float fx_px = 900.0F;
-  float fy_px = 900.0F;
-  float cx_px = 255.5F;
-  float cy_px = 255.5F;
-  int width_px = 512;
-  int height_px = 512;
-};
 
 /// A depth image borrowed from its owner: depth_m[v * stride + u] is the z of pixel (u, v) in
 /// metres, 0 (or non-finite) where no 3-D value was measured.

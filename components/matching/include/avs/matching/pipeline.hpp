@@ -18,9 +18,9 @@
 namespace avs::matching {
 
 struct PipelineConfig {
-  /// The paper's sensor as decode::default_sensor_geometry() models it: 512 x 512,
-  /// f = 256 / tan(22.15 deg) = 628.8 px, principal point at the centre.
-  CameraIntrinsics camera{628.8F, 628.8F, 255.5F, 255.5F, 512, 512};
+  /// The depth camera: the matching component sets it from /depth/camera_info (offline users
+  /// from the calibration file); process() rejects an unset one.
+  geometry::CameraModel camera;
   /// Target mask: pixels with depth_min_m <= z <= depth_max_m (SceneCloudConfig's min/max depth
   /// are overwritten by these).
   float depth_min_m = 0.3F;
@@ -71,6 +71,8 @@ class MatchingPipeline {
   PipelineOutput process(const DepthView& depth, double stamp_s, double data_age_s);
 
   void reset() { tracker_.reset(); }
+  /// The camera model in force (from /depth/camera_info); the tracker's state is kept.
+  void set_camera(const geometry::CameraModel& camera) { config_.camera = camera; }
   [[nodiscard]] const Points& scene_points() const { return *scene_; }
   [[nodiscard]] const ModelCloud& model() const { return model_; }
   [[nodiscard]] const PipelineConfig& config() const { return config_; }

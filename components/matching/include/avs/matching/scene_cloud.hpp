@@ -29,7 +29,8 @@ class SceneCloudBuilder {
   explicit SceneCloudBuilder(SceneCloudConfig config = {}) : config_(config) {}
 
   /// Returns the S-PCD in the camera frame (valid until the next call).
-  const Points& build(const DepthView& depth, const MaskView& mask, const CameraIntrinsics& camera);
+  const Points& build(const DepthView& depth, const MaskView& mask,
+                      const geometry::CameraModel& camera);
 
   /// Number of valid target pixels M of the last frame (Eq. 27).
   [[nodiscard]] std::size_t valid_pixels() const { return valid_pixels_; }

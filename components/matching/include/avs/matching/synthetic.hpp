@@ -48,9 +48,10 @@ struct DepthImage {
 };
 
 /// Renders the mesh seen by the camera (z-buffer over pixel centres; both triangle sides).
+/// Pinhole only: throws std::invalid_argument for a camera with lens distortion.
 [[nodiscard]] DepthImage render_depth(const geometry::Mesh& mesh,
                                       const Eigen::Isometry3f& T_camera_model,
-                                      const CameraIntrinsics& camera);
+                                      const geometry::CameraModel& camera);
 
 /// Adds seeded Gaussian noise of sigma_m to every valid depth.
 void add_depth_noise(DepthImage& image, float sigma_m, std::uint32_t seed);

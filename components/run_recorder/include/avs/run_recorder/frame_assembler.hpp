@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 
+#include "avs/geometry/camera_model.hpp"
 #include "avs/report/run_data.hpp"
 
 namespace avs::run_recorder {
@@ -23,12 +24,9 @@ struct Truth {
   double tilt_rad = 0;
 };
 
-struct CameraModel {
-  double fx_px = 628.8, fy_px = 628.8, cx_px = 255.5, cy_px = 255.5;
-  int width = 512, height = 512;
-  /// The object origin projects inside the image (ground-truth "in view").
-  [[nodiscard]] bool in_view(const Eigen::Vector3d& p_camera_m) const;
-};
+/// The object origin is in front of the camera and projects inside its image (ground-truth
+/// "in view"), lens distortion included.
+[[nodiscard]] bool in_view(const geometry::CameraModel& camera, const Eigen::Vector3d& p_camera_m);
 
 struct AssemblerStats {
   std::uint64_t rows_written = 0;
@@ -42,7 +40,11 @@ class FrameAssembler {
 
   /// Rows are complete once `settle_updates` newer depth updates have arrived (the pieces of
   /// one update arrive within the same sim-time step in lockstep; 2 leaves a margin).
-  FrameAssembler(CameraModel camera, RowSink sink, int settle_updates = 2);
+  explicit FrameAssembler(RowSink sink, int settle_updates = 2);
+
+  /// The camera model in force (/depth/camera_info). Until it is known, rows have no
+  /// in-view flag set and no centroid.
+  void set_camera(const geometry::CameraModel& camera) { camera_ = camera; }
 
   void on_truth(std::int64_t stamp_ns, const Truth& truth);
   void on_depth(std::int64_t stamp_ns);
@@ -65,7 +67,7 @@ class FrameAssembler {
   void emit(std::int64_t stamp_ns, Pending& p);
   void emit_settled();
 
-  CameraModel camera_;
+  std::optional<geometry::CameraModel> camera_;
   RowSink sink_;
   int settle_updates_;
   std::map<std::int64_t, Pending> pending_;

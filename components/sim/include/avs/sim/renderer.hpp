@@ -22,8 +22,9 @@ namespace avs::sim {
 
 struct RendererConfig {
   /// Camera and projector lenses, their relative pose and the code layout: the decoder's
-  /// defaults (Tables 1-2, sections 4.1 and 4.3; see decode/sensor_geometry.hpp). Lens
-  /// distortion is not rendered: set_view() throws if either lens has distortion terms.
+  /// defaults (Tables 1-2, sections 4.1 and 4.3; see decode/sensor_geometry.hpp). The camera's
+  /// lens distortion is rendered (the ideal pinhole image, remapped bilinearly to the camera's
+  /// pixels before noise); the projector's is not yet: the constructor throws for it.
   decode::SensorGeometry geometry = decode::default_sensor_geometry();
   /// Light levels as fractions of the 8-bit full scale (255 DN), before albedo. Not given
   /// in the paper (our choice): dim room light, a bright projector (150 lm, Table 1).
@@ -117,12 +118,15 @@ class Renderer {
   template <bool kWithTruth>
   void compute_row(int y, Truth* truth);
   const Truth& truth() const;
+  /// The camera without distortion, widened by a margin when the camera has distortion, and
+  /// remap_ for it (empty without distortion).
+  geometry::CameraModel make_pinhole_and_remap(const geometry::CameraModel& camera);
   template <typename ValueFn>
   void quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) const;
 
   RendererConfig config_;
   PinholeView camera_view_, shadow_view_;
-  decode::LensModel projector_;
+  geometry::CameraModel projector_;
   std::vector<std::int16_t> row_code_;   ///< code of each projector row, -1 if uncoded
   std::vector<std::int8_t> noise_bank_;  ///< N(0, 1) samples x 32, drawn once from noise_seed
   Eigen::Matrix3f R_projector_camera_;
@@ -150,6 +154,15 @@ class Renderer {
   std::vector<float> base_dn_, gain_dn_;
   std::vector<std::uint16_t> gray_;
   mutable Truth truth_;  ///< filled lazily by truth()
+  /// With lens distortion: per camera pixel, the four pinhole pixels (camera_view_) around the
+  /// ideal point it sees, bilinear weights, and the nearest of them (for the ground truth).
+  struct RemapEntry {
+    std::uint32_t index[4];
+    float weight[4];
+    std::uint32_t nearest;
+  };
+  std::vector<RemapEntry> remap_;
+  mutable Truth truth_camera_;  ///< truth_ remapped to the camera's pixels (distortion only)
 };
 
 /// The noise key of a frame: mixes the frame index so consecutive frames are independent.

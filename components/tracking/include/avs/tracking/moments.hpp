@@ -8,14 +8,9 @@
 
 #include <Eigen/Core>
 
-namespace avs::tracking {
+#include "avs/geometry/camera_model.hpp"
 
-struct CameraIntrinsics {
-  double fx_px = 0;
-  double fy_px = 0;
-  double cx_px = 0;
-  double cy_px = 0;
-};
+namespace avs::tracking {
 
 /// Row-major float32 depth image in metres; NaN (or any value outside the window) is not target.
 struct DepthImageView {
@@ -36,15 +31,17 @@ struct TargetObservation {
   double m00 = 0;        ///< area in pixels (Eq. 7, k = l = 0)
   double m10 = 0;        ///< sum of x_c over the mask, x_c = u - cx (pixels)
   double m01 = 0;        ///< sum of y_c over the mask, y_c = v - cy (pixels)
-  /// Centroid m_g = [m10/m00, m01/m00] (Eq. 9) relative to the principal point, pixels.
+  /// Centroid m_g = [m10/m00, m01/m00] (Eq. 9) relative to the principal point, pixels of the
+  /// ideal pinhole (lens distortion removed from the centroid, so Eq. 10 holds).
   Eigen::Vector2d m_g_px = Eigen::Vector2d::Zero();
-  double centroid_u_px = 0;  ///< m_g in image pixel coordinates (u right, v down)
+  double centroid_u_px = 0;  ///< the mask's centroid in image pixels (u right, v down)
   double centroid_v_px = 0;
   double mean_depth_m = 0;  ///< X_c: mean depth over the mask
 };
 
-/// Eqs. 7-9 over the whole image. Pixel centres are at integer (u, v).
-TargetObservation measure_target(const DepthImageView& depth, const CameraIntrinsics& camera,
+/// Eqs. 7-9 over the whole image. Pixel centres are at integer (u, v). The moments are sums
+/// over image pixels; with lens distortion, m_g is the undistorted centroid.
+TargetObservation measure_target(const DepthImageView& depth, const geometry::CameraModel& camera,
                                  const MomentsConfig& config);
 
 }  // namespace avs::tracking

@@ -22,8 +22,9 @@ struct ServoLawConfig {
   double fx_px = 0;  ///< focal length f in pixels along x (row 1 of J)
   double fy_px = 0;  ///< along y (row 2 of J)
   double a_m = 0.0;  ///< Figure 3: offset from the tilt axis to the camera centre along X_c
-  Eigen::Vector2d kp_nm_per_rad = {2.0, 0.3};        ///< K_p (pan, tilt)
-  Eigen::Vector2d kv_nm_s_per_rad = {0.1, 0.015};    ///< K_v (pan, tilt)
+  /// K_p, K_v (pan, tilt): tuned on servo_tracking_loop.yaml, what every experiment uses.
+  Eigen::Vector2d kp_nm_per_rad = {12.0, 2.0};
+  Eigen::Vector2d kv_nm_s_per_rad = {0.3, 0.05};
   Eigen::Vector2d m_d_px = Eigen::Vector2d::Zero();  ///< desired image position, usually 0
   Eigen::Vector2d max_torque_nm = {5.73, 0.9555};    ///< Table 3 motor limits
   double min_cos_q2 = 0.1;                           ///< keeps J invertible near tilt = +-90 deg

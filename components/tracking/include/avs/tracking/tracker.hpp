@@ -50,6 +50,11 @@ class Tracker {
 
   TrackingState state() const { return state_; }
   const TrackerConfig& config() const { return config_; }
+  /// The servo law's focal lengths (Eq. 15), from the camera model in force.
+  void set_focal_lengths_px(double fx_px, double fy_px) {
+    config_.law.fx_px = fx_px;
+    config_.law.fy_px = fy_px;
+  }
   void reset() { *this = Tracker(config_); }
 
  private:
