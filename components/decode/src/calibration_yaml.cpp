@@ -8,13 +8,13 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/LU>
 
+#include "avs/runtime/text.hpp"
+
 namespace avs::decode {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const YAML::Node& node, const std::string& what) {
-  const auto mark = node.Mark();
-  throw std::runtime_error(source + ":" + std::to_string(mark.line + 1) + ":" +
-                           std::to_string(mark.column + 1) + ": " + what);
+  throw std::runtime_error(runtime::yaml_location(source, node.Mark()) + ": " + what);
 }
 
 void check_keys(const std::string& source, const YAML::Node& node,

@@ -14,6 +14,7 @@
 
 #include "avs/geometry/builtin_models.hpp"
 #include "avs/geometry/primitives.hpp"
+#include "avs/runtime/text.hpp"
 
 namespace avs::sim {
 namespace {
@@ -26,10 +27,7 @@ class Parser {
         models_dir_(std::move(models_dir)) {}
 
   [[noreturn]] void fail(const YAML::Node& node, const std::string& what) const {
-    const YAML::Mark mark = node.Mark();
-    if (mark.is_null()) throw std::runtime_error(name_ + ": " + what);
-    throw std::runtime_error(name_ + ":" + std::to_string(mark.line + 1) + ":" +
-                             std::to_string(mark.column + 1) + ": " + what);
+    throw std::runtime_error(runtime::yaml_location(name_, node.Mark()) + ": " + what);
   }
 
   template <typename T>

@@ -5,35 +5,13 @@
 #include <sstream>
 
 #include "avs/deploy/deployment.hpp"
+#include "avs/runtime/text.hpp"
 
 namespace avs::deploy {
 namespace {
 
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 std::string file_uri(const std::string& path) {
-  return "file:" + xml_escape(path);
+  return "file:" + runtime::escape_markup(path);
 }
 
 }  // namespace
@@ -66,9 +44,9 @@ std::string cyclone_config(const Deployment& d, const Host& host, const std::str
   if (!host.interface.empty() || !host.address.empty()) {
     x << "<Interfaces><NetworkInterface ";
     if (!host.interface.empty()) {
-      x << "name=\"" << xml_escape(host.interface) << "\"";
+      x << "name=\"" << runtime::escape_markup(host.interface) << "\"";
     } else {
-      x << "address=\"" << xml_escape(host.address) << "\"";
+      x << "address=\"" << runtime::escape_markup(host.address) << "\"";
     }
     x << "/></Interfaces>";
   }
@@ -93,7 +71,7 @@ std::string cyclone_config(const Deployment& d, const Host& host, const std::str
     }
     if (!peers.empty()) {
       x << "<Peers>";
-      for (const auto& p : peers) x << "<Peer address=\"" << xml_escape(p) << "\"/>";
+      for (const auto& p : peers) x << "<Peer address=\"" << runtime::escape_markup(p) << "\"/>";
       x << "</Peers>";
     }
   }

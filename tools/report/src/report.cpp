@@ -6,34 +6,12 @@
 
 #include "avs/report/paper.hpp"
 #include "avs/report/table.hpp"
+#include "avs/runtime/text.hpp"
 
 namespace avs::report {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string escape_html(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 void write_file(const fs::path& file, const std::string& text) {
   std::ofstream out(file, std::ios::trunc);
@@ -58,51 +36,55 @@ std::string render_index_html(const RunInfo& info, const Summary& summary, const
                               const std::vector<std::string>& warnings) {
   std::ostringstream h;
   h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<title>avs report: " << escape_html(info.scenario) << "</title>\n<style>\n"
+    << "<title>avs report: " << runtime::escape_markup(info.scenario) << "</title>\n<style>\n"
     << kStyle << "\n</style>\n</head>\n<body>\n"
-    << "<h1>avs report: " << escape_html(info.scenario) << "</h1>\n"
-    << "<p>Target <b>" << escape_html(info.object) << "</b> (symmetry <code>"
-    << escape_html(info.symmetry) << "</code>), " << format_figure(summary.frames)
+    << "<h1>avs report: " << runtime::escape_markup(info.scenario) << "</h1>\n"
+    << "<p>Target <b>" << runtime::escape_markup(info.object) << "</b> (symmetry <code>"
+    << runtime::escape_markup(info.symmetry) << "</code>), " << format_figure(summary.frames)
     << " depth updates over " << format_figure(summary.duration_s)
     << " s of simulation time. Every number and figure below is computed from this folder's "
        "<a href=\"frames.csv\">frames.csv</a> by <code>avs report</code>; the paper's column "
        "quotes Sec. 7 of the paper.</p>\n";
-  if (!info.notes.empty()) h << "<p>" << escape_html(info.notes) << "</p>\n";
+  if (!info.notes.empty()) h << "<p>" << runtime::escape_markup(info.notes) << "</p>\n";
   for (const std::string& warning : warnings) {
-    h << "<p class=\"warn\">" << escape_html(warning) << "</p>\n";
+    h << "<p class=\"warn\">" << runtime::escape_markup(warning) << "</p>\n";
   }
 
   // 1. Results: the paper beside ours.
   h << "<h2>Results</h2>\n<table>\n<tr><th>figure</th><th>paper</th><th>ours</th><th>unit</th>"
        "<th>section</th></tr>\n";
   for (const ComparisonRow& row : comparison_rows(info.scenario, summary)) {
-    h << "<tr><td>" << escape_html(row.label) << "</td><td class=\"num\">" << escape_html(row.paper)
-      << "</td><td class=\"num\">" << format_figure(row.ours) << "</td><td>"
-      << escape_html(row.unit) << "</td><td>" << escape_html(row.section) << "</td></tr>\n";
+    h << "<tr><td>" << runtime::escape_markup(row.label) << "</td><td class=\"num\">"
+      << runtime::escape_markup(row.paper) << "</td><td class=\"num\">" << format_figure(row.ours)
+      << "</td><td>" << runtime::escape_markup(row.unit) << "</td><td>"
+      << runtime::escape_markup(row.section) << "</td></tr>\n";
   }
-  h << "</table>\n<p>" << escape_html(kPaperNote) << "</p>\n";
+  h << "</table>\n<p>" << runtime::escape_markup(kPaperNote) << "</p>\n";
 
   // 2. Figures.
   h << "<h2>Figures</h2>\n";
   for (const Plot& plot : plots.made) {
-    h << "<figure id=\"" << escape_html(plot.png) << "\">\n<h3>" << escape_html(plot.title)
-      << "</h3>\n<img src=\"" << escape_html(plot.png) << "\" alt=\"" << escape_html(plot.title)
-      << "\">\n<figcaption>" << escape_html(plot.caption) << " Made by <a href=\""
-      << escape_html(plot.script) << "\">" << escape_html(plot.script) << "</a>.";
+    h << "<figure id=\"" << runtime::escape_markup(plot.png) << "\">\n<h3>"
+      << runtime::escape_markup(plot.title) << "</h3>\n<img src=\""
+      << runtime::escape_markup(plot.png) << "\" alt=\"" << runtime::escape_markup(plot.title)
+      << "\">\n<figcaption>" << runtime::escape_markup(plot.caption) << " Made by <a href=\""
+      << runtime::escape_markup(plot.script) << "\">" << runtime::escape_markup(plot.script)
+      << "</a>.";
     if (!plot.gnuplot_stderr.empty()) {
-      h << " <span class=\"warn\">gnuplot: " << escape_html(plot.gnuplot_stderr) << "</span>";
+      h << " <span class=\"warn\">gnuplot: " << runtime::escape_markup(plot.gnuplot_stderr)
+        << "</span>";
     }
     h << "</figcaption>\n</figure>\n";
   }
   if (!plots.skipped.empty() || !plots.failed.empty()) {
     h << "<h3>Figures not made</h3>\n<ul>\n";
     for (const SkippedPlot& s : plots.skipped) {
-      h << "<li><code>" << escape_html(s.png) << "</code>: no data: " << escape_html(s.reason)
-        << "</li>\n";
+      h << "<li><code>" << runtime::escape_markup(s.png)
+        << "</code>: no data: " << runtime::escape_markup(s.reason) << "</li>\n";
     }
     for (const SkippedPlot& s : plots.failed) {
-      h << "<li class=\"warn\"><code>" << escape_html(s.png)
-        << "</code>: FAILED: " << escape_html(s.reason) << "</li>\n";
+      h << "<li class=\"warn\"><code>" << runtime::escape_markup(s.png)
+        << "</code>: FAILED: " << runtime::escape_markup(s.reason) << "</li>\n";
     }
     h << "</ul>\n";
   }
@@ -112,8 +94,8 @@ std::string render_index_html(const RunInfo& info, const Summary& summary, const
        "</p>\n<table>\n<tr><th>key</th><th>value</th><th>meaning</th></tr>\n";
   for (const SummaryField& field : summary_fields()) {
     h << "<tr><td><code>" << field.key << "</code></td><td class=\"num\">"
-      << format_figure(summary.*field.member) << "</td><td>" << escape_html(field.description)
-      << "</td></tr>\n";
+      << format_figure(summary.*field.member) << "</td><td>"
+      << runtime::escape_markup(field.description) << "</td></tr>\n";
   }
   h << "</table>\n<h2>Data</h2>\n<p><a href=\"frames.csv\">frames.csv</a>, <a "
        "href=\"meta.csv\">meta.csv</a>; the format is described in docs/report.md. "
