@@ -1,5 +1,5 @@
 // avs report DIR: re-makes a run folder's report (summary.json, figures, index.html) from its
-// CSV data and prints the results table. The library is tools/report (docs/report.md).
+// CSV data and prints the results table. The library is libs/report (docs/report.md).
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -35,7 +35,7 @@ void add_report_command(CLI::App& app) {
     options.plots.gnuplot_program = gnuplot;
     exit_status() = avs::report::report_main(dir, std::cout, std::cerr, options);
 #else
-    std::cerr << "avs report: this avs was built without tools/report (AVS_ONLY_SUBDIRS)\n";
+    std::cerr << "avs report: this avs was built without libs/report\n";
     exit_status() = 1;
 #endif
   });
