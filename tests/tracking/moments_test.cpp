@@ -15,7 +15,7 @@ struct Image {
   int width = 64;
   int height = 48;
   std::vector<float> depth = std::vector<float>(64 * 48, 3.0f);  // background beyond phi_h
-  DepthImageView view() const { return {depth.data(), width, height, 0}; }
+  geometry::DepthView view() const { return {depth.data(), width, height, 0}; }
   void fill_rect(int u0, int v0, int w, int h, float d) {
     for (int v = v0; v < v0 + h; ++v)
       for (int u = u0; u < u0 + w; ++u) depth[v * width + u] = d;
@@ -67,7 +67,7 @@ TEST(Moments, RowStrideIsHonoured) {
   Image img;
   img.fill_rect(40, 5, 2, 2, 1.0f);  // right half: outside a 32-wide view with stride 64
   img.fill_rect(3, 7, 1, 1, 1.0f);   // left half: inside
-  const DepthImageView left_half{img.depth.data(), 32, 48, 64};
+  const geometry::DepthView left_half{img.depth.data(), 32, 48, 64};
   const TargetObservation obs = measure_target(left_half, camera, {0.5, 1.5, 1});
   EXPECT_DOUBLE_EQ(obs.m00, 1);
   EXPECT_DOUBLE_EQ(obs.centroid_u_px, 3);

@@ -17,9 +17,9 @@
 #include "avs/matching/pipeline.hpp"
 #include "avs/msg/camera_input.hpp"
 #include "avs/msg/convert.hpp"
+#include "avs/msg/depth_image.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
-#include "avs/runtime/depth_image.hpp"
 #include "avs/runtime/rejections.hpp"
 
 namespace avs::matching {
@@ -264,16 +264,15 @@ class MatchingComponent final : public runtime::Component {
 
   void on_depth(const msgs::sensor_msgs::Image& image) {
     std::string why;
-    const auto layout = runtime::depth_image_layout(image, &why);
+    const auto layout = msg::depth_view(image, &why);
     if (!layout) {
       rejected_.reject(why);
       return;
     }
-    if (!camera_.accepts_image(layout->width, layout->height)) return;
+    if (!camera_.accepts_image(layout->width_px, layout->height_px)) return;
     ++images_;
     const double stamp_s = runtime::from_ros_time(image.header.stamp).seconds();
-    const DepthView depth{layout->depth_m, layout->width, layout->height,
-                          layout->row_stride_floats};
+    const DepthView& depth = *layout;
     const std::optional<double> age = age_at(stamp_s);
     if (age) ++aged_images_;
     const PipelineOutput out =

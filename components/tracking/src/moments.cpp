@@ -5,24 +5,24 @@
 
 namespace avs::tracking {
 
-TargetObservation measure_target(const DepthImageView& depth, const geometry::CameraModel& camera,
-                                 const MomentsConfig& config) {
-  if (depth.depth_m == nullptr && depth.width * depth.height != 0) {
+TargetObservation measure_target(const geometry::DepthView& depth,
+                                 const geometry::CameraModel& camera, const MomentsConfig& config) {
+  if (depth.depth_m == nullptr && depth.width_px * depth.height_px != 0) {
     throw std::invalid_argument("measure_target: null depth image of " +
-                                std::to_string(depth.width) + "x" + std::to_string(depth.height));
+                                std::to_string(depth.width_px) + "x" +
+                                std::to_string(depth.height_px));
   }
-  const std::size_t stride = depth.row_stride_floats != 0 ? depth.row_stride_floats
-                                                          : static_cast<std::size_t>(depth.width);
+  const auto stride = static_cast<std::size_t>(depth.stride());
   const float lo = static_cast<float>(config.depth_min_m);
   const float hi = static_cast<float>(config.depth_max_m);
   // Sums per row in integers/floats, then in double: exact for 512x512 images.
   double m00 = 0, m10 = 0, m01 = 0, depth_sum = 0;
-  for (int v = 0; v < depth.height; ++v) {
+  for (int v = 0; v < depth.height_px; ++v) {
     const float* row = depth.depth_m + static_cast<std::size_t>(v) * stride;
     long count = 0;
     long u_sum = 0;
     double row_depth = 0;
-    for (int u = 0; u < depth.width; ++u) {
+    for (int u = 0; u < depth.width_px; ++u) {
       const float h = row[u];
       if (lo < h && h < hi) {  // Eq. 8 (NaN compares false)
         ++count;

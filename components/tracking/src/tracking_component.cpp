@@ -13,9 +13,9 @@
 
 #include "avs/msg/camera_input.hpp"
 #include "avs/msg/convert.hpp"
+#include "avs/msg/depth_image.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
-#include "avs/runtime/depth_image.hpp"
 #include "avs/runtime/rejections.hpp"
 #include "avs/tracking/tracker.hpp"
 
@@ -177,19 +177,15 @@ class TrackingComponent final : public runtime::Component {
 
   void on_depth(const msgs::sensor_msgs::Image& image) {
     std::string why;
-    const auto layout = runtime::depth_image_layout(image, &why);
+    const auto layout = msg::depth_view(image, &why);
     if (!layout) {
       rejected_.reject(why);
       return;
     }
-    if (!camera_.accepts_image(layout->width, layout->height)) return;
+    if (!camera_.accepts_image(layout->width_px, layout->height_px)) return;
     ++images_;
     const auto started = std::chrono::steady_clock::now();
-    DepthImageView view;
-    view.depth_m = layout->depth_m;
-    view.width = layout->width;
-    view.height = layout->height;
-    view.row_stride_floats = static_cast<std::size_t>(layout->row_stride_floats);
+    const geometry::DepthView& view = *layout;
     TargetObservation obs = measure_target(view, *camera_.model(), moments_);  // Eqs. 7-9
     if (obs.present) ++frames_with_target_;
     publish_target(image, obs);

@@ -8,20 +8,16 @@
 #include <Eigen/Geometry>
 
 #include "avs/geometry/camera_model.hpp"
+#include "avs/geometry/depth_view.hpp"
 
 namespace avs::matching {
 
 /// A point cloud: positions in metres, in the frame named by the variable (p_camera, p_model).
 using Points = std::vector<Eigen::Vector3f>;
 
-/// A depth image borrowed from its owner: depth_m[v * stride + u] is the z of pixel (u, v) in
-/// metres, 0 (or non-finite) where no 3-D value was measured.
-struct DepthView {
-  const float* depth_m = nullptr;
-  int width_px = 0;
-  int height_px = 0;
-  int stride_px = 0;  ///< elements per row; 0 means width_px
-};
+/// A depth image borrowed from its owner (z of pixel (u, v) in metres, 0 or non-finite where
+/// nothing was measured): the project's one depth view type.
+using geometry::DepthView;
 
 /// Optional target mask, same layout as the depth image: non-zero = pixel belongs to the target.
 struct MaskView {

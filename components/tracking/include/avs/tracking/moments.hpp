@@ -9,16 +9,9 @@
 #include <Eigen/Core>
 
 #include "avs/geometry/camera_model.hpp"
+#include "avs/geometry/depth_view.hpp"
 
 namespace avs::tracking {
-
-/// Row-major float32 depth image in metres; NaN (or any value outside the window) is not target.
-struct DepthImageView {
-  const float* depth_m = nullptr;
-  int width = 0;
-  int height = 0;
-  std::size_t row_stride_floats = 0;  ///< 0: width
-};
 
 struct MomentsConfig {
   double depth_min_m = 0.3;  ///< phi_l (Eq. 8)
@@ -39,9 +32,10 @@ struct TargetObservation {
   double mean_depth_m = 0;  ///< X_c: mean depth over the mask
 };
 
-/// Eqs. 7-9 over the whole image. Pixel centres are at integer (u, v). The moments are sums
-/// over image pixels; with lens distortion, m_g is the undistorted centroid.
-TargetObservation measure_target(const DepthImageView& depth, const geometry::CameraModel& camera,
-                                 const MomentsConfig& config);
+/// Eqs. 7-9 over the whole image (NaN, or any value outside the window, is not target). Pixel
+/// centres are at integer (u, v). The moments are sums over image pixels; with lens distortion, m_g
+/// is the undistorted centroid.
+TargetObservation measure_target(const geometry::DepthView& depth,
+                                 const geometry::CameraModel& camera, const MomentsConfig& config);
 
 }  // namespace avs::tracking
