@@ -1,9 +1,10 @@
 #include "avs/matching/pipeline.hpp"
 
 #include <chrono>
-#include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
+
+#include "avs/geometry/builtin_models.hpp"
 
 namespace avs::matching {
 namespace {
@@ -125,13 +126,6 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
   return out;
 }
 
-std::string default_models_dir() {
-  if (const char* source = std::getenv("AVS_SOURCE_DIR"); source != nullptr && *source != 0) {
-    return std::string(source) + "/models";
-  }
-  return AVS_MATCHING_MODELS_DIR;
-}
-
 ObjectModel load_object_model(const std::string& name_or_path, const std::string& models_dir) {
   ObjectModel object;
   struct Preset {
@@ -153,8 +147,8 @@ ObjectModel load_object_model(const std::string& name_or_path, const std::string
     object.scene_points = preset.scene_points;
     object.symmetry = preset.symmetry;
     if (preset.symmetry == Symmetry::cylinder_z) object.metric = IcpMetric::point_to_point;
-    object.mesh_path =
-        (models_dir.empty() ? default_models_dir() : models_dir) + "/" + preset.name + ".ply";
+    object.mesh_path = (models_dir.empty() ? geometry::default_models_dir() : models_dir) + "/" +
+                       preset.name + ".ply";
   }
   if (object.mesh_path == name_or_path) {
     object.name = std::filesystem::path(name_or_path).stem().string();

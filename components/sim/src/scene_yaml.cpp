@@ -153,7 +153,8 @@ class Parser {
       std::string path;
       if (node["model"]) {
         const std::string model = get<std::string>(node, "model", "");
-        path = (models_dir_.empty() ? default_models_dir() : models_dir_) + "/" + model + ".ply";
+        path = (models_dir_.empty() ? geometry::default_models_dir() : models_dir_) + "/" + model +
+               ".ply";
       } else {
         path = get<std::string>(node, "mesh", "");
         if (!std::filesystem::path(path).is_absolute()) path = base_dir_ + "/" + path;
@@ -205,13 +206,6 @@ class Parser {
 };
 
 }  // namespace
-
-std::string default_models_dir() {
-  if (const char* source = std::getenv("AVS_SOURCE_DIR"); source != nullptr && *source != 0) {
-    return std::string(source) + "/models";
-  }
-  return AVS_DEFAULT_MODELS_DIR;
-}
 
 SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_errors,
                       const std::string& base_dir, const std::string& models_dir) {

@@ -222,7 +222,7 @@ class SimScene final : public runtime::Component {
       const auto names = geometry::builtin_model_names();
       const bool builtin = std::find(names.begin(), names.end(), object) != names.end();
       target.mesh = std::make_shared<const geometry::Mesh>(
-          builtin ? geometry::load_mesh(default_models_dir() + "/" + object + ".ply")
+          builtin ? geometry::load_mesh(geometry::default_models_dir() + "/" + object + ".ply")
                   : geometry::load_mesh(object));
       target.name = builtin ? object : fs::path(object).stem().string();
     }

@@ -20,4 +20,8 @@ std::vector<std::string> builtin_model_names();
 /// Throws std::invalid_argument for an unknown name.
 Mesh make_builtin_model(const std::string& name);
 
+/// The folder the shipped models/*.ply are read from: $AVS_SOURCE_DIR/models when that is set,
+/// else the source tree's models/ (the one lookup every component and tool uses).
+std::string default_models_dir();
+
 }  // namespace avs::geometry

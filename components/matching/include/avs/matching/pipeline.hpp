@@ -114,7 +114,6 @@ struct ObjectModel {
 [[nodiscard]] ObjectModel load_object_model(const std::string& name_or_path,
                                             const std::string& models_dir = "");
 
-/// Directory the built-in models are read from when models_dir is empty.
-[[nodiscard]] std::string default_models_dir();
+/// (The folder of the built-in models: geometry::default_models_dir().)
 
 }  // namespace avs::matching

@@ -22,7 +22,4 @@ SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_
 /// Reads and parses a scene file; meshes relative to the file's directory.
 SceneFile load_scene(const std::string& path, const std::string& models_dir = "");
 
-/// Directory the built-in models are loaded from (see parse_scene).
-std::string default_models_dir();
-
 }  // namespace avs::sim
