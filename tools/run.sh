@@ -62,6 +62,9 @@ case "${1:-}" in
     ;;
   test)
     install_missing "${DEMO_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
+    # Debian's nodejs comes without npm (a separate package); a nodejs that bundles npm (and
+    # conflicts with Debian's) needs none. The MCAP reader check needs npm.
+    command -v npm >/dev/null || install_missing npm
     build "$BUILD_DIR"
     cd "$BUILD_DIR"
     exec ctest --output-on-failure -j "$JOBS" --timeout 600

@@ -9,8 +9,9 @@ src="$1/tests/mcap/js"
 work="$2"
 fixture="$3"
 if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
-  echo "SKIPPED: node/npm not installed (apt-get install nodejs npm)" >&2
-  exit 77
+  # The test command installs them (tools/run.sh); a skip here would hide a missing step.
+  echo "FAILED: node/npm not installed (bash tools/run.sh test installs nodejs and npm)" >&2
+  exit 1
 fi
 mkdir -p "$work"
 cp "$src/package.json" "$src/package-lock.json" "$src/check_mcap.mjs" "$work/"
