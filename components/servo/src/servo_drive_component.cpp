@@ -6,7 +6,8 @@
 //   * on its own thread (own_thread: true, wall time / real hardware), with an absolute
 //     schedule on the steady clock and optional SCHED_FIFO priority.
 // Publishes /head/joint_states every good cycle and /head/drive_status at status_rate_hz (and
-// at once when the link or fault state changes); takes /head/torque_command and /head/estop.
+// at once when the link or fault state changes); takes /head/torque_command, /head/estop and
+// /head/fault_reset (the only way to clear a latched fault unless auto_fault_reset).
 #include <pthread.h>
 #include <sched.h>
 
@@ -97,6 +98,10 @@ class ServoDrive final : public runtime::Component {
     using runtime::QosProfile;
     QosProfile keep_last_1;
     keep_last_1.depth = 1;
+    // Fault reset requests: reliable and volatile, keep last 10 = what a plain ROS 2 publisher
+    // offers, so `ros2 topic pub --once /head/fault_reset std_msgs/msg/Empty` matches. Not
+    // transient local: an old request must never reset a fault that happens later.
+    const QosProfile reset_qos;
     QosProfile estop_qos;
     estop_qos.depth = 1;
     estop_qos.durability = runtime::Durability::transient_local;
@@ -192,7 +197,9 @@ class ServoDrive final : public runtime::Component {
                           "drive_status", "/head/drive_status", keep_last_1)},
         .subscribes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
                            "torque_command", "/head/torque_command", keep_last_1),
-                       runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos)}};
+                       runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
+                       runtime::port<msgs::std_msgs::Empty>("fault_reset", "/head/fault_reset",
+                                                            reset_qos)}};
   }
 
   explicit ServoDrive(ComponentContext& ctx)
@@ -228,6 +235,8 @@ class ServoDrive final : public runtime::Component {
         [this](runtime::SamplePtr<msgs::avs_msgs::JointTorqueCommand> m) { on_command(*m); });
     ctx.subscribe<msgs::std_msgs::Bool>(
         "estop", [this](runtime::SamplePtr<msgs::std_msgs::Bool> m) { on_estop(m->data); });
+    ctx.subscribe<msgs::std_msgs::Empty>(
+        "fault_reset", [this](runtime::SamplePtr<msgs::std_msgs::Empty>) { on_fault_reset(); });
   }
 
   ~ServoDrive() override { stop_thread(); }
@@ -427,6 +436,11 @@ class ServoDrive final : public runtime::Component {
     if (active != estop_.load()) log().warn(active ? "e-stop engaged" : "e-stop released");
     estop_ = active;
     client_->set_estop(active, context().now().seconds());
+  }
+
+  void on_fault_reset() {
+    log().info("fault reset requested");
+    client_->request_fault_reset();
   }
 
   void thread_loop() {
