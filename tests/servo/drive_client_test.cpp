@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "avs/servo/amplifier_server.hpp"
 
 namespace avs::servo {
@@ -27,7 +29,7 @@ class DriveClientTest : public ::testing::Test {
     DriveClientConfig c = default_drive_client_config("127.0.0.1", server_->port());
     c.cycle_rate_hz = rate_hz;
     c.response_timeout_s = 0.02;
-    c.command_timeout_s = 3 * period_s;
+    c.command_freshness.timeout_s = 3 * period_s;
     c.reconnect_backoff_initial_s = period_s;
     c.reconnect_backoff_max_s = 4 * period_s;
     return c;
@@ -63,7 +65,7 @@ class DriveClientTest : public ::testing::Test {
     server_->with_drive(axis, [&](SimulatedDrive& d) { s = d.state_machine().state(); });
     return s;
   }
-  void command(double pan, double tilt) { client_->set_command({pan, tilt}, t_); }
+  void command(double pan, double tilt) { client_->set_command({pan, tilt}, t_, t_); }
 
   std::unique_ptr<AmplifierServer> server_;
   std::unique_ptr<DriveClient> client_;
@@ -96,7 +98,7 @@ TEST_F(DriveClientTest, EnablesOnActivateAndAppliesTheCommand) {
 TEST_F(DriveClientTest, CommandsFromBeforeActivationAreDiscarded) {
   client_ = std::make_unique<DriveClient>(client_config());
   client_->connect();
-  client_->set_command({1.0, 0.0}, t_);
+  client_->set_command({1.0, 0.0}, t_, t_);
   t_ += 1e-3;
   client_->activate(t_);
   for (int i = 0; i < 6; ++i) cycle();
@@ -149,6 +151,25 @@ TEST_F(DriveClientTest, StaleCommandGivesZeroTorque) {
   for (int i = 0; i < 4; ++i) r = cycle();  // 4 periods > 3-period command timeout
   EXPECT_EQ(drive_command(), 0.0);
   EXPECT_TRUE(r.axes[0].safety_reasons & safety_command_stale);
+}
+
+// Issue 20 1.1: one command stamped far in the future stayed applied for the rest of the run
+// (its stamp age never exceeded the timeout); 0.5 s of clock skew kept it for 0.54 s.
+TEST_F(DriveClientTest, FutureStampedCommandIsRejected) {
+  start(client_config());
+  for (const double ahead_s : {3600.0, 0.5}) {
+    EXPECT_FALSE(client_->set_command({1.0, 0.1}, t_ + ahead_s, t_));
+    for (int i = 0; i < 8; ++i) {
+      const CycleResult r = cycle();
+      ASSERT_EQ(r.axes[0].commanded_torque_nm, 0.0)
+          << "stamped " << ahead_s << " s ahead, cycle " << i;
+      ASSERT_EQ(drive_command(), 0.0);
+    }
+  }
+  EXPECT_EQ(client_->command_statistics().future_stamped, 2u);
+  // Within the tolerance a stamp ahead is taken, but it ages from its arrival as well.
+  EXPECT_TRUE(client_->set_command({1.0, 0.1}, t_ + 0.004, t_));
+  EXPECT_GT(cycle().axes[0].commanded_torque_nm, 0.5);
 }
 
 TEST_F(DriveClientTest, EstopGivesZeroTorqueWithinOnePeriod) {
@@ -205,7 +226,8 @@ TEST_F(DriveClientTest, SilentAmplifierGivesZeroTorqueAndFaultWithinTwoPeriodsTh
   // The watchdog latched a drive fault; a fault reset brings torque back.
   EXPECT_EQ(drive_state(), DriveState::fault);
   client_->request_fault_reset();
-  for (int i = 0; i < 8; ++i) {
+  // Reset edge, enable sequence, then fault_clear_stable_cycles of Operation enabled.
+  for (int i = 0; i < 16; ++i) {
     command(1.0, 0.1);
     cycle();
   }
@@ -265,6 +287,37 @@ TEST_F(DriveClientTest, DriveFaultIsReportedAndNeedsAReset) {
   EXPECT_EQ(drive_state(1), DriveState::operation_enabled);
 }
 
+// Issue 20 1.2: a statusword going from Fault straight back to Operation enabled (no reset
+// written) gave torque again at once, even with auto_fault_reset false.
+TEST_F(DriveClientTest, FaultLatchesZeroTorqueUntilAResetAndAStableEnable) {
+  start(client_config());  // auto_fault_reset: false
+  server_->raise_drive_fault(0, error_code_injected);
+  for (int i = 0; i < 2; ++i) {
+    command(1.0, 0.1);
+    cycle();  // Fault reaction active, then Fault, seen by the host
+  }
+  ASSERT_EQ(drive_state(0), DriveState::fault);
+  server_->with_drive(0, [](SimulatedDrive& d) { d.leave_fault_without_reset(); });
+  for (int i = 0; i < 20; ++i) {
+    command(1.0, 0.1);
+    const CycleResult r = cycle();
+    ASSERT_EQ(r.axes[0].commanded_torque_nm, 0.0) << "cycle " << i << " after the fault cleared";
+    ASSERT_EQ(applied(0), 0.0) << "cycle " << i;
+  }
+  // The host's enable sequence ran again (the drive is enabled), yet no torque was written.
+  ASSERT_EQ(drive_state(0), DriveState::operation_enabled);
+  EXPECT_NEAR(applied(1), 0.1, tilt_rated_torque_nm / 1000);  // the other axis is not latched
+  // A reset request unlatches, but only after several consecutive Operation-enabled cycles.
+  client_->request_fault_reset();
+  int first_torque_cycle = -1;
+  for (int i = 0; i < 20 && first_torque_cycle < 0; ++i) {
+    command(1.0, 0.1);
+    if (cycle().axes[0].commanded_torque_nm > 0) first_torque_cycle = i;
+  }
+  EXPECT_GE(first_torque_cycle, 2);
+  EXPECT_LE(first_torque_cycle, 8);
+}
+
 TEST_F(DriveClientTest, WrongWordOrderIsRefusedAtConfigure) {
   DriveClientConfig config = client_config();
   config.axes[0].registers[Signal::word_order_probe].word_order = WordOrder::low_first;
@@ -316,6 +369,72 @@ TEST(DriveClientConfigCheck, RefusesAResponseTimeoutLongerThanThePeriod) {
   DriveClientConfig config = default_drive_client_config("127.0.0.1", 502);
   config.response_timeout_s = 0.5;
   EXPECT_THROW(DriveClient{config}, ConfigError);
+}
+
+// Issue 20 1.4: soft limits with only a brake zone let a held 1 N m take pan to 4.18 rad
+// (limit 3.0), a saturated command to 7.0 rad (tilt -3.84 against -1.4). At 1 kHz in
+// lockstep, with the plant's truth checked every cycle.
+class SoftLimitEnvelopeTest : public ::testing::Test {
+ protected:
+  static constexpr double envelope_period_s = 0.001;
+  static constexpr double overshoot_tolerance_rad = 0.001;  // stated bound: 1 mrad
+
+  void SetUp() override {
+    AmplifierServerConfig server_config;
+    for (auto& axis : server_config.axes) axis.watchdog_timeout_s = 0.01;
+    server_ = std::make_unique<AmplifierServer>(server_config);
+    server_->step(envelope_period_s);
+    DriveClientConfig c = default_drive_client_config("127.0.0.1", server_->port());
+    c.cycle_rate_hz = 1.0 / envelope_period_s;
+    c.response_timeout_s = 0.05;  // lockstep: waiting costs no simulated time
+    c.require_timeout_within_period = false;
+    c.axes[0].safety.soft_lower_rad = -3.0;
+    c.axes[0].safety.soft_upper_rad = 3.0;
+    c.axes[1].safety.soft_lower_rad = -1.4;
+    c.axes[1].safety.soft_upper_rad = 1.4;
+    client_ = std::make_unique<DriveClient>(c);
+    client_->connect();
+    client_->activate(t_);
+    for (int i = 0; i < 6; ++i) step(0.0, 0.0);
+  }
+
+  void step(double pan_nm, double tilt_nm) {
+    t_ += envelope_period_s;
+    client_->set_command({pan_nm, tilt_nm}, t_, t_);
+    client_->cycle(t_);
+    server_->step(envelope_period_s);
+    server_->with_drive(0, [&](SimulatedDrive& d) {
+      max_pan_rad_ = std::max(max_pan_rad_, d.plant().state().q_rad);
+      min_pan_rad_ = std::min(min_pan_rad_, d.plant().state().q_rad);
+    });
+    server_->with_drive(1, [&](SimulatedDrive& d) {
+      max_tilt_rad_ = std::max(max_tilt_rad_, d.plant().state().q_rad);
+      min_tilt_rad_ = std::min(min_tilt_rad_, d.plant().state().q_rad);
+    });
+  }
+
+  std::unique_ptr<AmplifierServer> server_;
+  std::unique_ptr<DriveClient> client_;
+  double t_ = 0;
+  double max_pan_rad_ = 0, min_pan_rad_ = 0, max_tilt_rad_ = 0, min_tilt_rad_ = 0;
+};
+
+TEST_F(SoftLimitEnvelopeTest, HeldOneNewtonMetreStopsBeforeThePanLimit) {
+  for (int i = 0; i < 400; ++i) step(1.0, 0.0);  // 0.4 s
+  for (int i = 0; i < 600; ++i) step(0.0, 0.0);  // and coasting afterwards
+  EXPECT_LE(max_pan_rad_, 3.0 + overshoot_tolerance_rad);
+  EXPECT_GT(max_pan_rad_, 2.9) << "the envelope must not stop the axis far from the limit";
+}
+
+TEST_F(SoftLimitEnvelopeTest, SaturatedCommandsStopBeforeTheLimits) {
+  for (int i = 0; i < 1000; ++i) step(100.0, -100.0);  // clamped to the motor limits
+  for (int i = 0; i < 500; ++i) step(0.0, 0.0);
+  EXPECT_LE(max_pan_rad_, 3.0 + overshoot_tolerance_rad);
+  EXPECT_GE(min_tilt_rad_, -1.4 - overshoot_tolerance_rad);
+  // The other direction too.
+  for (int i = 0; i < 1500; ++i) step(-100.0, 100.0);
+  EXPECT_GE(min_pan_rad_, -3.0 - overshoot_tolerance_rad);
+  EXPECT_LE(max_tilt_rad_, 1.4 + overshoot_tolerance_rad);
 }
 
 }  // namespace

@@ -143,6 +143,13 @@ void Cia402StateMachine::raise_fault(std::uint16_t error_code, bool latched_only
   if (state_ != DriveState::fault) state_ = DriveState::fault_reaction_active;
 }
 
+void Cia402StateMachine::leave_fault_without_reset() {
+  if (state_ != DriveState::fault && state_ != DriveState::fault_reaction_active) return;
+  state_ = DriveState::operation_enabled;
+  error_code_ = 0;
+  fault_cause_active_ = false;
+}
+
 void Cia402StateMachine::step(bool motion_stopped) {
   switch (state_) {
     case DriveState::not_ready_to_switch_on:

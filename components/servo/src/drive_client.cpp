@@ -5,7 +5,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
+#include <poll.h>
+#include <sys/socket.h>
+
+#include "avs/servo/modbus_frame.hpp"
 #include "avs/servo/plant.hpp"
 
 namespace avs::servo {
@@ -16,6 +21,13 @@ constexpr Signal cyclic_writes[] = {Signal::controlword, Signal::target_torque,
 constexpr Signal cyclic_reads[] = {
     Signal::statusword,      Signal::mode_display,    Signal::torque_actual, Signal::error_code,
     Signal::position_actual, Signal::velocity_actual, Signal::echo_counter};
+
+/// The envelope's physical model of an axis: the plant model's inertia, gear and efficiency.
+void set_envelope_model(AxisSafetyConfig& safety, const AxisPlantConfig& plant) {
+  safety.output_inertia_kg_m2 = plant.inertia_kgm2;
+  safety.gear_ratio = plant.gear_ratio;
+  safety.gear_efficiency = plant.efficiency;
+}
 
 std::string axis_label(const DriveAxisConfig& axis) {
   return "axis " + axis.name + " (unit " + std::to_string(axis.unit_id) + ")";
@@ -41,6 +53,7 @@ DriveClientConfig default_drive_client_config(const std::string& host, int port)
   pan.registers = default_register_map(pan_rated_torque_nm, pan_rad_per_count);
   pan.safety.configured_max_torque_nm = 5.73;
   pan.safety.motor_max_torque_nm = 5.73;
+  set_envelope_model(pan.safety, pan_plant_config());
   DriveAxisConfig tilt;
   tilt.name = "tilt";
   tilt.unit_id = 2;
@@ -48,6 +61,7 @@ DriveClientConfig default_drive_client_config(const std::string& host, int port)
   tilt.safety.configured_max_torque_nm = 0.9555;
   tilt.safety.motor_max_torque_nm = 0.9555;
   tilt.safety.brake_gain_nm_s_per_rad = 0.01;
+  set_envelope_model(tilt.safety, tilt_plant_config());
   c.axes = {pan, tilt};
   return c;
 }
@@ -55,6 +69,9 @@ DriveClientConfig default_drive_client_config(const std::string& host, int port)
 DriveClient::DriveClient(DriveClientConfig config) : config_(std::move(config)), rtt_us_(8192) {
   if (config_.axes.empty()) throw ConfigError("servo_drive: no axes configured");
   if (!(config_.cycle_rate_hz > 0)) throw ConfigError("servo_drive: cycle_rate_hz must be > 0");
+  if (config_.fault_clear_stable_cycles < 1) {
+    throw ConfigError("servo_drive: fault_clear_stable_cycles must be >= 1");
+  }
   const double period_s = 1.0 / config_.cycle_rate_hz;
   if (!(config_.response_timeout_s > 0) ||
       (config_.require_timeout_within_period &&
@@ -76,6 +93,7 @@ DriveClient::DriveClient(DriveClientConfig config) : config_(std::move(config)),
       throw ConfigError("servo_drive: " + axis_label(axis) + ": " + e.what());
     }
     AxisRuntime rt;
+    rt.latch = FaultLatch(config_.fault_clear_stable_cycles);
     // Contiguous runs of the cyclically written registers.
     std::vector<const RegisterSpec*> writes;
     for (Signal s : cyclic_writes) {
@@ -249,6 +267,7 @@ void DriveClient::activate(double now_s) {
   accept_after_s_ = now_s;
   std::fill(command_nm_.begin(), command_nm_.end(), 0.0);
   command_stamp_s_ = std::numeric_limits<double>::quiet_NaN();
+  command_arrival_s_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 void DriveClient::deactivate() {
@@ -266,17 +285,38 @@ void DriveClient::set_estop(bool active, double now_s) {
   if (estop_ && !active) {
     accept_after_s_ = now_s;
     command_stamp_s_ = std::numeric_limits<double>::quiet_NaN();
+    command_arrival_s_ = std::numeric_limits<double>::quiet_NaN();
   }
   estop_ = active;
 }
 
-void DriveClient::set_command(const std::vector<double>& torque_nm, double stamp_s) {
+bool DriveClient::set_command(const std::vector<double>& torque_nm, double stamp_s,
+                              double arrival_s) {
   std::lock_guard lock(command_mutex_);
-  if (stamp_s < accept_after_s_) return;  // from before activation / e-stop release
+  if (stamp_s < accept_after_s_) {  // from before activation / e-stop release
+    ++command_stats_.before_activation;
+    return false;
+  }
+  // A stamp from the future would stay "fresh" until our clock caught up with it (issue 20
+  // 1.1): refuse it; the previous command keeps ageing as before.
+  if (is_future_stamped(config_.command_freshness, stamp_s, arrival_s) ||
+      !std::isfinite(stamp_s)) {
+    ++command_stats_.future_stamped;
+    command_stats_.last_future_ahead_s = stamp_s - arrival_s;
+    return false;
+  }
   const std::size_t n = std::min(torque_nm.size(), command_nm_.size());
   std::copy_n(torque_nm.begin(), n, command_nm_.begin());
   std::fill(command_nm_.begin() + static_cast<std::ptrdiff_t>(n), command_nm_.end(), 0.0);
   command_stamp_s_ = stamp_s;
+  command_arrival_s_ = arrival_s;
+  ++command_stats_.accepted;
+  return true;
+}
+
+CommandStatistics DriveClient::command_statistics() const {
+  std::lock_guard lock(command_mutex_);
+  return command_stats_;
 }
 
 LinkStatistics DriveClient::statistics() const {
@@ -326,6 +366,90 @@ std::uint16_t DriveClient::next_controlword(std::size_t axis, bool want_enabled,
   }
 }
 
+DriveClient::ExchangeError DriveClient::classify_modbus_errno(int err) {
+  if (err == ETIMEDOUT) return ExchangeError::timeout;
+  if (err > MODBUS_ENOBASE && err < MODBUS_ENOBASE + 12) return ExchangeError::exception;
+  // A reply that does not answer the request: another slave, bad CRC, data or length.
+  if (err == EMBBADSLAVE || err == EMBBADCRC || err == EMBBADDATA || err == EMBMDATA ||
+      err == EMBBADEXC) {
+    return ExchangeError::bad_reply;
+  }
+  return ExchangeError::io;
+}
+
+namespace {
+
+/// Waits until `fd` is readable or the deadline (steady clock) has passed.
+bool wait_readable(int fd, std::chrono::steady_clock::time_point deadline) {
+  const auto left = deadline - std::chrono::steady_clock::now();
+  if (left <= std::chrono::steady_clock::duration::zero()) return false;
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(left).count();
+  timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
+  pollfd p{fd, POLLIN, 0};
+  return ::ppoll(&p, 1, &timeout, nullptr) > 0;
+}
+
+enum class ReadResult : std::uint8_t { ok, timeout, closed };
+
+ReadResult read_exact(int fd, std::span<std::uint8_t> out,
+                      std::chrono::steady_clock::time_point deadline) {
+  std::size_t done = 0;
+  while (done < out.size()) {
+    if (!wait_readable(fd, deadline)) return ReadResult::timeout;
+    const ssize_t n = ::recv(fd, out.data() + done, out.size() - done, 0);
+    if (n == 0) return ReadResult::closed;
+    if (n < 0) {
+      if (errno == EINTR || errno == EAGAIN) continue;
+      return ReadResult::closed;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return ReadResult::ok;
+}
+
+}  // namespace
+
+DriveClient::ExchangeError DriveClient::tcp_transaction(std::uint8_t unit_id,
+                                                        const RequestPdu& request,
+                                                        std::span<std::uint16_t> registers,
+                                                        std::string& message) {
+  const int fd = modbus_get_socket(ctx_.get());
+  transaction_id_ = static_cast<std::uint16_t>(transaction_id_ + 1);
+  const std::vector<std::uint8_t> adu = encode_tcp_request(transaction_id_, unit_id, request);
+  for (std::size_t sent = 0; sent < adu.size();) {
+    const ssize_t n = ::send(fd, adu.data() + sent, adu.size() - sent, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      message = std::string("send: ") + std::strerror(errno);
+      return ExchangeError::io;
+    }
+    sent += static_cast<std::size_t>(n);
+  }
+  const auto deadline = std::chrono::steady_clock::now() +
+                        std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                            std::chrono::duration<double>(config_.response_timeout_s));
+  auto failed = [&](ReadResult r) {
+    message = r == ReadResult::timeout ? "Connection timed out" : "connection closed by the peer";
+    return r == ReadResult::timeout ? ExchangeError::timeout : ExchangeError::io;
+  };
+  std::uint8_t header[mbap_header_bytes];
+  if (const ReadResult r = read_exact(fd, header, deadline); r != ReadResult::ok) return failed(r);
+  std::size_t pdu_bytes = 0;
+  ReplyCheck check = check_tcp_reply_header(header, transaction_id_, unit_id, request, pdu_bytes);
+  if (check.ok()) {
+    std::vector<std::uint8_t> pdu(pdu_bytes);
+    if (const ReadResult r = read_exact(fd, pdu, deadline); r != ReadResult::ok) return failed(r);
+    check = check_reply_pdu(pdu, request, registers);
+  }
+  if (check.ok()) return ExchangeError::none;
+  if (check.problem == ReplyProblem::exception) {
+    message = check.message;
+    return ExchangeError::exception;
+  }
+  message = "bad reply: " + check.message;
+  return ExchangeError::bad_reply;
+}
+
 DriveClient::ExchangeError DriveClient::exchange(std::size_t axis, std::uint16_t cw,
                                                  double torque_nm, AxisFeedback& fb,
                                                  std::string& message) {
@@ -353,24 +477,56 @@ DriveClient::ExchangeError DriveClient::exchange(std::size_t axis, std::uint16_t
 
   std::uint16_t regs[MODBUS_MAX_WR_READ_REGISTERS] = {};
   const double t0 = monotonic_us();
-  int rc = modbus_set_slave(ctx_.get(), cfg.unit_id);
-  if (rc != -1 && config_.use_write_read_0x17 && rt.write_runs.size() == 1) {
-    rc = modbus_write_and_read_registers(ctx_.get(), base, rt.write_runs.front().count, image,
-                                         rt.read_address, rt.read_count, regs);
-  } else {
-    for (const WriteRun& run : rt.write_runs) {
-      if (rc == -1) break;
-      rc = modbus_write_registers(ctx_.get(), run.address, run.count, image + (run.address - base));
+  const bool one_transaction = config_.use_write_read_0x17 && rt.write_runs.size() == 1;
+  ExchangeError error = ExchangeError::none;
+  if (config_.transport == Transport::tcp) {
+    // Our own framing, so that every reply is checked (unit id, length, ...) before use.
+    const auto unit = static_cast<std::uint8_t>(cfg.unit_id);
+    if (one_transaction) {
+      error = tcp_transaction(
+          unit,
+          write_read_registers_request(base, std::span(image, rt.write_runs.front().count),
+                                       rt.read_address, rt.read_count),
+          regs, message);
+    } else {
+      for (const WriteRun& run : rt.write_runs) {
+        if (error != ExchangeError::none) break;
+        error = tcp_transaction(
+            unit,
+            write_registers_request(run.address,
+                                    std::span(image + (run.address - base), run.count)),
+            {}, message);
+      }
+      if (error == ExchangeError::none) {
+        error = tcp_transaction(unit, read_registers_request(rt.read_address, rt.read_count), regs,
+                                message);
+      }
     }
-    if (rc != -1) rc = modbus_read_registers(ctx_.get(), rt.read_address, rt.read_count, regs);
+  } else {
+    // RTU: libmodbus checks the slave address, CRC, function and byte count itself.
+    int rc = modbus_set_slave(ctx_.get(), cfg.unit_id);
+    if (rc != -1 && one_transaction) {
+      rc = modbus_write_and_read_registers(ctx_.get(), base, rt.write_runs.front().count, image,
+                                           rt.read_address, rt.read_count, regs);
+    } else {
+      for (const WriteRun& run : rt.write_runs) {
+        if (rc == -1) break;
+        rc = modbus_write_registers(ctx_.get(), run.address, run.count,
+                                    image + (run.address - base));
+      }
+      if (rc != -1) rc = modbus_read_registers(ctx_.get(), rt.read_address, rt.read_count, regs);
+    }
+    if (rc == -1) {
+      const int err = errno;
+      message = modbus_strerror(err);
+      error = classify_modbus_errno(err);
+      if (error == ExchangeError::bad_reply) message = "bad reply: " + message;
+    }
   }
   const double rtt_us = monotonic_us() - t0;
-  if (rc == -1) {
-    const int err = errno;
-    message = axis_label(cfg) + ": " + modbus_strerror(err);
-    if (err == ETIMEDOUT) return ExchangeError::timeout;
-    if (err > MODBUS_ENOBASE && err < MODBUS_ENOBASE + 12) return ExchangeError::exception;
-    return ExchangeError::io;
+  if (error != ExchangeError::none) {
+    message = axis_label(cfg) + ": " + message;
+    return error;
   }
   auto get = [&](Signal s) {
     const RegisterSpec& spec = map[s];
@@ -418,6 +574,9 @@ void DriveClient::on_link_fault(double now_s, ExchangeError error, const std::st
       case ExchangeError::stale:
         ++stats_.stale_replies;
         break;
+      case ExchangeError::bad_reply:
+        ++stats_.bad_replies;
+        break;
       default:
         ++stats_.errors;
         break;
@@ -425,7 +584,8 @@ void DriveClient::on_link_fault(double now_s, ExchangeError error, const std::st
   }
   // Best effort torque 0 while the link may still carry it (not after a timeout: the drive's
   // own watchdog covers that, and another timeout would overrun the cycle).
-  if (error == ExchangeError::stale || error == ExchangeError::exception) {
+  if (error == ExchangeError::stale || error == ExchangeError::exception ||
+      error == ExchangeError::bad_reply) {
     for (const DriveAxisConfig& axis : config_.axes) {
       modbus_set_slave(ctx_.get(), axis.unit_id);
       modbus_write_register(ctx_.get(), axis.registers[Signal::target_torque].address, 0);
@@ -447,6 +607,7 @@ CycleResult DriveClient::cycle(double now_s) {
   // Snapshot of the commands.
   std::vector<double> command;
   double stamp = 0;
+  double arrival = 0;
   bool want_enabled = false;
   bool estop = false;
   bool reset = false;
@@ -454,6 +615,7 @@ CycleResult DriveClient::cycle(double now_s) {
     std::lock_guard lock(command_mutex_);
     command = command_nm_;
     stamp = command_stamp_s_;
+    arrival = command_arrival_s_;
     want_enabled = want_enabled_;
     estop = estop_;
     reset = fault_reset_requested_ || config_.auto_fault_reset;
@@ -498,15 +660,22 @@ CycleResult DriveClient::cycle(double now_s) {
     SafetyInput in;
     in.command_nm = command[i];
     in.command_stamp_s = stamp;
+    in.command_arrival_s = arrival;
     in.now_s = now_s;
     in.estop = estop;
     in.link_healthy = true;
     in.drive_enabled =
         want_enabled && rt.last.valid && rt.last.state == DriveState::operation_enabled;
+    in.fault_latched = rt.latch.latched();
     in.feedback_valid = rt.last.valid;
     in.q_rad = rt.last.q_rad;
     in.qd_rad_s = rt.last.qd_rad_s;
-    const SafetyOutput safe = apply_safety(cfg.safety, config_.command_timeout_s, in);
+    // The feedback was read one exchange ago; the torque written then acts until this one
+    // lands, and this one holds for a period (the velocity envelope needs both).
+    in.previous_torque_nm = rt.last.commanded_torque_nm;
+    in.feedback_age_s = rt.last.valid ? std::max(0.0, now_s - rt.last_time_s) : 0.0;
+    in.command_hold_s = 1.0 / config_.cycle_rate_hz;
+    const SafetyOutput safe = apply_safety(cfg.safety, config_.command_freshness, in);
     const std::uint16_t cw = next_controlword(i, want_enabled, estop, reset);
 
     AxisFeedback fb;
@@ -525,7 +694,9 @@ CycleResult DriveClient::cycle(double now_s) {
     fb.commanded_torque_nm = safe.torque_nm;
     fb.controlword = cw;
     fb.safety_reasons = safe.reasons;
+    fb.fault_latched = rt.latch.update(fb.state, reset);
     rt.last = fb;
+    rt.last_time_s = now_s;
     result.axes[i] = fb;
     if (fb.state == DriveState::fault || fb.state == DriveState::fault_reaction_active) {
       any_fault_state = true;
@@ -535,6 +706,11 @@ CycleResult DriveClient::cycle(double now_s) {
                       axis_label(cfg).c_str(), fb.error_code);
         result.fault_message = msg;
       }
+    } else if (fb.fault_latched && result.fault_message.empty()) {
+      result.fault_message = "servo_drive: " + axis_label(cfg) +
+                             ": fault latched, zero torque until a fault reset request and " +
+                             std::to_string(config_.fault_clear_stable_cycles) +
+                             " cycles of Operation enabled";
     }
   }
   backoff_s_ = config_.reconnect_backoff_initial_s;

@@ -63,14 +63,14 @@ LoopFigures run_ours(int port, double rate_hz, double seconds) {
   DriveClientConfig config = default_drive_client_config("127.0.0.1", port);
   config.cycle_rate_hz = rate_hz;
   config.response_timeout_s = 0.4 / rate_hz;
-  config.command_timeout_s = 0.05;
+  config.command_freshness.timeout_s = 0.05;
   DriveClient client(config);
   client.connect();
   client.activate(now_s());
   LoopFigures fig;
   SampleWindow jitter(1 << 20);
   run_periodic(rate_hz, seconds, jitter, fig, [&](double t) {
-    client.set_command({0.05 * std::sin(2 * M_PI * t), 0.01 * std::sin(2 * M_PI * t)}, t);
+    client.set_command({0.05 * std::sin(2 * M_PI * t), 0.01 * std::sin(2 * M_PI * t)}, t, t);
     if (client.cycle(t).link_fault) ++fig.faults;
   });
   const LinkStatistics stats = client.statistics();

@@ -6,7 +6,8 @@
 //   * on its own thread (own_thread: true, wall time / real hardware), with an absolute
 //     schedule on the steady clock and optional SCHED_FIFO priority.
 // Publishes /head/joint_states every good cycle and /head/drive_status at status_rate_hz (and
-// at once when the link or fault state changes); takes /head/torque_command and /head/estop.
+// at once when the link or fault state changes); takes /head/torque_command, /head/estop and
+// /head/fault_reset (the only way to clear a latched fault unless auto_fault_reset).
 #include <pthread.h>
 #include <sched.h>
 
@@ -88,9 +89,19 @@ std::vector<RegisterMap> load_maps(const std::string& path, const std::vector<st
 class ServoDrive final : public runtime::Component {
  public:
   static ComponentSpec spec() {
+    // Defaults from the cores (one fact in one place): safety rules and the plant model.
+    const CommandFreshness freshness;
+    const AxisSafetyConfig safety;
+    const DriveClientConfig client;
+    const AxisPlantConfig pan_plant = pan_plant_config();
+    const AxisPlantConfig tilt_plant = tilt_plant_config();
     using runtime::QosProfile;
     QosProfile keep_last_1;
     keep_last_1.depth = 1;
+    // Fault reset requests: reliable and volatile, keep last 10 = what a plain ROS 2 publisher
+    // offers, so `ros2 topic pub --once /head/fault_reset std_msgs/msg/Empty` matches. Not
+    // transient local: an old request must never reset a fault that happens later.
+    const QosProfile reset_qos;
     QosProfile estop_qos;
     estop_qos.depth = 1;
     estop_qos.durability = runtime::Durability::transient_local;
@@ -126,8 +137,17 @@ class ServoDrive final : public runtime::Component {
                              "in wall time, 1 s in sim time (waiting costs no simulated time)"),
              ParamSpec::boolean("use_write_read_0x17", true,
                                 "one 0x17 write+read per axis, else 0x10 + 0x03"),
-             ParamSpec::real("command_timeout_s", 0.02, 0.0001, 10.0, "s",
-                             "torque commands older than this -> zero torque"),
+             ParamSpec::real("command_timeout_s", freshness.timeout_s, 0.0001, 10.0, "s",
+                             "torque commands whose stamp or arrival is older than this -> "
+                             "zero torque"),
+             ParamSpec::real("command_future_tolerance_s", freshness.future_tolerance_s, 0.0,
+                             1.0, "s",
+                             "torque commands stamped later than their arrival by more than "
+                             "this are rejected and counted (sender clock ahead)"),
+             ParamSpec::integer("fault_clear_stable_cycles", client.fault_clear_stable_cycles, 1,
+                                100000, "",
+                                "a drive fault latches zero torque until a reset request and "
+                                "this many consecutive cycles of Operation enabled"),
              ParamSpec::real_list("max_torque_nm", {5.73, 0.9555}, "N m",
                                   "configured motor torque limit per axis (also written to the "
                                   "drive's max_torque)"),
@@ -141,6 +161,19 @@ class ServoDrive final : public runtime::Component {
                              "braking zone inside each soft limit"),
              ParamSpec::real_list("brake_gain_nm_s_per_rad", {0.05, 0.01}, "N m s/rad",
                                   "braking torque per output rad/s toward a nearby limit"),
+             ParamSpec::real_list("output_inertia_kg_m2",
+                                  {pan_plant.inertia_kgm2, tilt_plant.inertia_kgm2}, "kg m2",
+                                  "output-side inertia J_eq per axis, for the soft-limit "
+                                  "velocity envelope (0 = no envelope)"),
+             ParamSpec::real_list("gear_ratio", {pan_plant.gear_ratio, tilt_plant.gear_ratio},
+                                  "", "motor turns per output turn, per axis (envelope)"),
+             ParamSpec::real_list("gear_efficiency",
+                                  {pan_plant.efficiency, tilt_plant.efficiency}, "",
+                                  "gear efficiency per axis (envelope)"),
+             ParamSpec::real("envelope_brake_fraction", safety.envelope_brake_fraction, 0.0, 1.0,
+                             "",
+                             "share of the full braking deceleration the velocity envelope "
+                             "plans with (the rest is margin); 0 = no envelope"),
              ParamSpec::string("estop_action", "disable_operation", "what an e-stop does",
                                {"disable_operation", "quick_stop"}),
              ParamSpec::boolean("auto_fault_reset", false,
@@ -164,7 +197,9 @@ class ServoDrive final : public runtime::Component {
                           "drive_status", "/head/drive_status", keep_last_1)},
         .subscribes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
                            "torque_command", "/head/torque_command", keep_last_1),
-                       runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos)}};
+                       runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
+                       runtime::port<msgs::std_msgs::Empty>("fault_reset", "/head/fault_reset",
+                                                            reset_qos)}};
   }
 
   explicit ServoDrive(ComponentContext& ctx)
@@ -200,6 +235,8 @@ class ServoDrive final : public runtime::Component {
         [this](runtime::SamplePtr<msgs::avs_msgs::JointTorqueCommand> m) { on_command(*m); });
     ctx.subscribe<msgs::std_msgs::Bool>(
         "estop", [this](runtime::SamplePtr<msgs::std_msgs::Bool> m) { on_estop(m->data); });
+    ctx.subscribe<msgs::std_msgs::Empty>(
+        "fault_reset", [this](runtime::SamplePtr<msgs::std_msgs::Empty>) { on_fault_reset(); });
   }
 
   ~ServoDrive() override { stop_thread(); }
@@ -251,7 +288,9 @@ class ServoDrive final : public runtime::Component {
     c.rtu.rts_delay_us = ctx.param<int>("rtu_rts_delay_us");
     c.rtu.drive_turnaround_s = ctx.param<double>("rtu_turnaround_s");
     c.cycle_rate_hz = ctx.param<double>("cycle_rate_hz");
-    c.command_timeout_s = ctx.param<double>("command_timeout_s");
+    c.command_freshness.timeout_s = ctx.param<double>("command_timeout_s");
+    c.command_freshness.future_tolerance_s = ctx.param<double>("command_future_tolerance_s");
+    c.fault_clear_stable_cycles = ctx.param<int>("fault_clear_stable_cycles");
     c.use_write_read_0x17 = ctx.param<bool>("use_write_read_0x17");
     c.reconnect_backoff_initial_s = ctx.param<double>("reconnect_backoff_initial_s");
     c.reconnect_backoff_max_s = ctx.param<double>("reconnect_backoff_max_s");
@@ -268,6 +307,9 @@ class ServoDrive final : public runtime::Component {
     const auto lower = ctx.param<std::vector<double>>("soft_lower_rad");
     const auto upper = ctx.param<std::vector<double>>("soft_upper_rad");
     const auto brake_gain = ctx.param<std::vector<double>>("brake_gain_nm_s_per_rad");
+    const auto inertia = ctx.param<std::vector<double>>("output_inertia_kg_m2");
+    const auto gear_ratio = ctx.param<std::vector<double>>("gear_ratio");
+    const auto gear_efficiency = ctx.param<std::vector<double>>("gear_efficiency");
     const std::string map_file = ctx.param<std::string>("register_map");
     std::vector<RegisterMap> maps;
     if (!map_file.empty()) {
@@ -297,6 +339,10 @@ class ServoDrive final : public runtime::Component {
       axis.safety.soft_upper_rad = element(upper, i, "soft_upper_rad");
       axis.safety.brake_zone_rad = ctx.param<double>("brake_zone_rad");
       axis.safety.brake_gain_nm_s_per_rad = element(brake_gain, i, "brake_gain_nm_s_per_rad");
+      axis.safety.output_inertia_kg_m2 = element(inertia, i, "output_inertia_kg_m2");
+      axis.safety.gear_ratio = element(gear_ratio, i, "gear_ratio");
+      axis.safety.gear_efficiency = element(gear_efficiency, i, "gear_efficiency");
+      axis.safety.envelope_brake_fraction = ctx.param<double>("envelope_brake_fraction");
       if (!(axis.safety.soft_lower_rad < axis.safety.soft_upper_rad)) {
         throw ConfigError("servo_drive: axis " + axis.name +
                           ": soft_lower_rad must be below "
@@ -352,13 +398,49 @@ class ServoDrive final : public runtime::Component {
         command[static_cast<std::size_t>(it - names_.begin())] = torques[j];
       }
     }
-    client_->set_command(command, runtime::from_ros_time(m.header.stamp).seconds());
+    const double arrival_s = context().now().seconds();
+    const double stamp_s = runtime::from_ros_time(m.header.stamp).seconds();
+    if (!client_->set_command(command, stamp_s, arrival_s)) report_refused_command(arrival_s);
+  }
+
+  /// Refused commands are counted by the client (and on /diagnostics); the log gets at most
+  /// one line per second of the container clock, so a sender stuck ahead cannot flood it.
+  void report_refused_command(double now_s) {
+    if (now_s - last_refusal_log_s_ < 1.0) return;
+    const CommandStatistics s = client_->command_statistics();
+    if (s.future_stamped == future_stamped_logged_) return;  // older than activation: expected
+    last_refusal_log_s_ = now_s;
+    future_stamped_logged_ = s.future_stamped;
+    log().warn("torque command rejected: stamped ", s.last_future_ahead_s,
+               " s after its arrival (tolerance ",
+               client_->config().command_freshness.future_tolerance_s,
+               " s; sender clock ahead?); ", s.future_stamped, " rejected so far");
+  }
+
+  std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
+    const LinkStatistics l = client_->statistics();
+    const CommandStatistics c = client_->command_statistics();
+    return {{"commands_accepted", std::to_string(c.accepted)},
+            {"commands_future_stamped", std::to_string(c.future_stamped)},
+            {"commands_before_activation", std::to_string(c.before_activation)},
+            {"exchanges", std::to_string(l.exchanges)},
+            {"timeouts", std::to_string(l.timeouts)},
+            {"exceptions", std::to_string(l.exceptions)},
+            {"stale_replies", std::to_string(l.stale_replies)},
+            {"bad_replies", std::to_string(l.bad_replies)},
+            {"errors", std::to_string(l.errors)},
+            {"reconnects", std::to_string(l.reconnects)}};
   }
 
   void on_estop(bool active) {
     if (active != estop_.load()) log().warn(active ? "e-stop engaged" : "e-stop released");
     estop_ = active;
     client_->set_estop(active, context().now().seconds());
+  }
+
+  void on_fault_reset() {
+    log().info("fault reset requested");
+    client_->request_fault_reset();
   }
 
   void thread_loop() {
@@ -449,7 +531,7 @@ class ServoDrive final : public runtime::Component {
       a.statusword = fb.statusword;
       a.controlword = fb.controlword;
       a.state = static_cast<std::uint8_t>(fb.state);
-      a.fault = r.link_fault || fb.state == DriveState::fault ||
+      a.fault = r.link_fault || fb.fault_latched || fb.state == DriveState::fault ||
                 fb.state == DriveState::fault_reaction_active;
       a.error_code = fb.error_code;
       a.commanded_torque_nm = fb.commanded_torque_nm;
@@ -457,7 +539,7 @@ class ServoDrive final : public runtime::Component {
     msg->link_ok = r.link_ok;
     msg->exchanges = s.exchanges;
     msg->timeouts = s.timeouts;
-    msg->errors = s.errors + s.exceptions + s.stale_replies;
+    msg->errors = s.errors + s.exceptions + s.stale_replies + s.bad_replies;
     msg->reconnects = s.reconnects;
     msg->rtt_us_p50 = std::isnan(s.rtt_us_p50) ? 0.0 : s.rtt_us_p50;
     msg->rtt_us_p99 = std::isnan(s.rtt_us_p99) ? 0.0 : s.rtt_us_p99;
@@ -493,8 +575,10 @@ class ServoDrive final : public runtime::Component {
          << "\nfirst_link_fault_s: " << first_link_fault_s_
          << "\nlast_link_fault_s: " << last_link_fault_s_ << "\nexchanges: " << s.exchanges
          << "\ntimeouts: " << s.timeouts << "\nexceptions: " << s.exceptions
-         << "\nstale_replies: " << s.stale_replies << "\nerrors: " << s.errors
+         << "\nstale_replies: " << s.stale_replies << "\nbad_replies: " << s.bad_replies
+         << "\nerrors: " << s.errors
          << "\nreconnects: " << s.reconnects << "\nconnect_failures: " << s.connect_failures
+         << "\ncommands_future_stamped: " << client_->command_statistics().future_stamped
          << "\nfirst_fault_message: \"" << first_fault_message_ << "\"\n";
     if (!csv || !yaml) log().error("cannot write the report to ", base, ".{csv,yaml}");
   }
@@ -513,6 +597,8 @@ class ServoDrive final : public runtime::Component {
   std::atomic<bool> stop_{false};
   std::atomic<bool> estop_{false};
   bool warned_unknown_joint_ = false;
+  double last_refusal_log_s_ = -1e300;  ///< subscription callback only
+  std::uint64_t future_stamped_logged_ = 0;
 
   // Cycle bookkeeping (cycle thread / timer only).
   std::int64_t cycles_ = 0;

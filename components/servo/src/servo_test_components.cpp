@@ -1,8 +1,10 @@
 // Small components for the servo graph tests (tests/integration_servo/):
-//   test_torque_step   - publishes a torque command schedule (zero, a step, zero) and an
-//                        optional e-stop window on the container clock;
+//   test_torque_step   - publishes a torque command schedule (zero, a step, zero), an
+//                        optional e-stop window and fault reset on the container clock,
+//                        optionally stamped ahead of the clock;
 //   test_head_recorder - records /sim/head_state and /head/joint_states to CSV files
 //                        <report_dir>/<name>_sim.csv and <name>_joints.csv on deactivate.
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -37,10 +39,16 @@ class TestTorqueStep final : public runtime::Component {
                        ParamSpec::real("estop_at_s", -1.0, -1.0, std::nullopt, "s",
                                        "publish e-stop true at this time (-1 = never)"),
                        ParamSpec::real("estop_release_s", -1.0, -1.0, std::nullopt, "s",
-                                       "publish e-stop false at this time (-1 = never)")},
+                                       "publish e-stop false at this time (-1 = never)"),
+                       ParamSpec::real("fault_reset_at_s", -1.0, -1.0, std::nullopt, "s",
+                                       "publish one /head/fault_reset at this time (-1 = never)"),
+                       ParamSpec::real("stamp_offset_s", 0.0, -1e6, 1e6, "s",
+                                       "stamp the commands this much after the clock (a "
+                                       "sender clock ahead, if positive)")},
         .publishes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
                           "torque_command", "/head/torque_command", keep_last_1),
-                      runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos)},
+                      runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
+                      runtime::port<msgs::std_msgs::Empty>("fault_reset", "/head/fault_reset")},
         .subscribes = {}};
   }
 
@@ -48,12 +56,15 @@ class TestTorqueStep final : public runtime::Component {
       : Component(ctx),
         command_(ctx.publisher<msgs::avs_msgs::JointTorqueCommand>("torque_command")),
         estop_(ctx.publisher<msgs::std_msgs::Bool>("estop")),
+        fault_reset_(ctx.publisher<msgs::std_msgs::Empty>("fault_reset")),
         period_(static_cast<std::int64_t>(1e9 / ctx.param<double>("rate_hz"))),
         torque_(ctx.param<std::vector<double>>("torque_nm")),
         step_at_s_(ctx.param<double>("step_at_s")),
         step_until_s_(ctx.param<double>("step_until_s")),
         estop_at_s_(ctx.param<double>("estop_at_s")),
-        estop_release_s_(ctx.param<double>("estop_release_s")) {
+        estop_release_s_(ctx.param<double>("estop_release_s")),
+        fault_reset_at_s_(ctx.param<double>("fault_reset_at_s")),
+        stamp_offset_(std::llround(ctx.param<double>("stamp_offset_s") * 1e9)) {
     const std::string names = ctx.param<std::string>("joint_names");
     for (std::size_t start = 0; start <= names.size();) {
       const std::size_t comma = std::min(names.find(',', start), names.size());
@@ -83,9 +94,13 @@ class TestTorqueStep final : public runtime::Component {
       publish_estop(false);
       release_sent_ = true;
     }
+    if (fault_reset_at_s_ >= 0 && !reset_sent_ && t >= fault_reset_at_s_) {
+      fault_reset_.publish(runtime::make_sample<msgs::std_msgs::Empty>());
+      reset_sent_ = true;
+    }
     const bool on = t >= step_at_s_ && t < step_until_s_;
     auto msg = runtime::make_sample<msgs::avs_msgs::JointTorqueCommand>();
-    runtime::to_ros_time(now, msg->header.stamp);
+    runtime::to_ros_time(now + stamp_offset_, msg->header.stamp);
     const auto n = static_cast<std::uint32_t>(names_.size());
     runtime::resize_sequence(msg->name, n);
     runtime::resize_sequence(msg->torque_nm, n);
@@ -104,6 +119,7 @@ class TestTorqueStep final : public runtime::Component {
 
   runtime::Publisher<msgs::avs_msgs::JointTorqueCommand> command_;
   runtime::Publisher<msgs::std_msgs::Bool> estop_;
+  runtime::Publisher<msgs::std_msgs::Empty> fault_reset_;
   runtime::Duration period_;
   std::vector<double> torque_;
   std::vector<std::string> names_;
@@ -111,8 +127,11 @@ class TestTorqueStep final : public runtime::Component {
   double step_until_s_;
   double estop_at_s_;
   double estop_release_s_;
+  double fault_reset_at_s_;
+  runtime::Duration stamp_offset_;
   bool estop_sent_ = false;
   bool release_sent_ = false;
+  bool reset_sent_ = false;
 };
 
 class TestHeadRecorder final : public runtime::Component {

@@ -69,6 +69,9 @@ class Cia402StateMachine {
   /// until clear_fault_cause() unless `latched_only` (cause already gone, only a reset needed).
   void raise_fault(std::uint16_t error_code, bool latched_only = true);
   void clear_fault_cause() { fault_cause_active_ = false; }
+  /// Fault injection: Fault (or Fault reaction active) -> Operation enabled without a reset,
+  /// as a drive that clears a fault on its own or a corrupted statusword would report.
+  void leave_fault_without_reset();
 
   /// Automatic transitions: Not ready -> Switch on disabled, Fault reaction -> Fault (torque off
   /// reaction), Quick stop active -> Switch on disabled once `motion_stopped` (option 2).

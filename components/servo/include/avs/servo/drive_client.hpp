@@ -8,11 +8,13 @@
 #include <cstdint>
 #include <limits>
 #include <mutex>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "avs/servo/cia402.hpp"
 #include "avs/servo/link_budget.hpp"
+#include "avs/servo/modbus_frame.hpp"
 #include "avs/servo/modbus_handle.hpp"
 #include "avs/servo/register_map.hpp"
 #include "avs/servo/safety.hpp"
@@ -64,7 +66,12 @@ struct DriveClientConfig {
   /// not cyclic: a loaded host must not fail the configuration for a reply a little slower than
   /// the cyclic budget. The larger of this and response_timeout_s applies.
   double configure_timeout_s = 0.05;
-  double command_timeout_s = 0.02;  ///< older commands -> zero torque
+  /// Stale-command limit (stamp or arrival older -> zero torque) and the tolerance for stamps
+  /// ahead of the arrival time (later ones are rejected and counted).
+  CommandFreshness command_freshness;
+  /// A drive fault latches zero torque until a reset request and this many consecutive
+  /// cycles of Operation enabled (FaultLatch).
+  int fault_clear_stable_cycles = 5;
   bool use_write_read_0x17 = true;  ///< else 0x10 write(s) + 0x03 read
   double reconnect_backoff_initial_s = 0.005;
   double reconnect_backoff_max_s = 0.5;
@@ -86,6 +93,7 @@ struct AxisFeedback {
   double commanded_torque_nm = 0;  ///< what this cycle wrote (0 when not written)
   std::uint16_t controlword = 0;   ///< what this cycle wrote
   std::uint32_t safety_reasons = safety_none;
+  bool fault_latched = false;  ///< FaultLatch: zero torque until reset and a stable enable
 };
 
 struct CycleResult {
@@ -100,11 +108,22 @@ struct LinkStatistics {
   std::uint64_t timeouts = 0;
   std::uint64_t exceptions = 0;     ///< Modbus exception replies
   std::uint64_t stale_replies = 0;  ///< echo counter mismatch
+  /// Replies that do not answer the request: wrong unit id, transaction or protocol id,
+  /// length, function code or byte count (TCP: checked here; RTU: by libmodbus).
+  std::uint64_t bad_replies = 0;
   std::uint64_t errors = 0;         ///< other I/O errors (reset, broken pipe, bad data)
   std::uint64_t reconnects = 0;     ///< successful re-connections after a fault
   std::uint64_t connect_failures = 0;
   double rtt_us_p50 = 0;  ///< per axis exchange, over the recent window
   double rtt_us_p99 = 0;
+};
+
+/// Torque commands refused by set_command().
+struct CommandStatistics {
+  std::uint64_t accepted = 0;
+  std::uint64_t future_stamped = 0;     ///< stamp ahead of the arrival beyond the tolerance
+  std::uint64_t before_activation = 0;  ///< stamped before activation / e-stop release
+  double last_future_ahead_s = 0;       ///< stamp - arrival of the last future-stamped one
 };
 
 class DriveClient {
@@ -127,17 +146,22 @@ class DriveClient {
   void activate(double now_s);
   /// Disable on deactivate: torque 0 and 0x07 (Switched on).
   void deactivate();
+  /// Resets latched faults: a drive in Fault gets the bit-7 edge; a latched axis gets torque
+  /// again once its drive has been Operation enabled for fault_clear_stable_cycles.
   void request_fault_reset();
   /// E-stop: from the next cycle torque 0 (and the estop action). Releasing it discards
   /// commands stamped before `now_s`.
   void set_estop(bool active, double now_s);
-  /// Latest torque command (motor N m, one per axis) stamped with the sender's time.
-  void set_command(const std::vector<double>& torque_nm, double stamp_s);
+  /// Latest torque command (motor N m, one per axis) stamped with the sender's time, received
+  /// at `arrival_s` (our clock). Returns false (and counts it) when it is refused: stamped
+  /// before activation / e-stop release, or later than the arrival plus the tolerance.
+  bool set_command(const std::vector<double>& torque_nm, double stamp_s, double arrival_s);
 
   /// One cyclic exchange with every axis at time now_s (same time base as the stamps).
   CycleResult cycle(double now_s);
 
   LinkStatistics statistics() const;
+  CommandStatistics command_statistics() const;
   const DriveClientConfig& config() const { return config_; }
   bool connected() const { return ctx_ != nullptr; }
   /// Non-empty once a reconnect found a configuration mismatch (e.g. word order): the client
@@ -155,9 +179,11 @@ class DriveClient {
     std::uint16_t read_count = 0;
     std::uint16_t counter = 0;
     AxisFeedback last;    ///< last good feedback
+    double last_time_s = 0;  ///< when `last` was read
     int reset_phase = 0;  ///< fault reset edge: 0 write bit 7 low, 1 write bit 7 high
+    FaultLatch latch;
   };
-  enum class ExchangeError : std::uint8_t { none, timeout, exception, stale, io };
+  enum class ExchangeError : std::uint8_t { none, timeout, exception, stale, bad_reply, io };
 
   void open_link();       ///< throws
   void configure_axes();  ///< throws
@@ -165,6 +191,11 @@ class DriveClient {
   std::uint16_t next_controlword(std::size_t axis, bool want_enabled, bool estop, bool reset);
   ExchangeError exchange(std::size_t axis, std::uint16_t controlword, double torque_nm,
                          AxisFeedback& feedback, std::string& message);
+  /// TCP: one request and its reply over the connected socket, the reply checked in full
+  /// (modbus_frame.hpp) before any register is taken.
+  ExchangeError tcp_transaction(std::uint8_t unit_id, const RequestPdu& request,
+                                std::span<std::uint16_t> registers, std::string& message);
+  static ExchangeError classify_modbus_errno(int err);
   void on_link_fault(double now_s, ExchangeError error, const std::string& message);
 
   DriveClientConfig config_;
@@ -173,16 +204,19 @@ class DriveClient {
   double next_connect_s_ = -std::numeric_limits<double>::infinity();
   double backoff_s_ = 0;
   bool had_fault_ = false;
+  std::uint16_t transaction_id_ = 0;  ///< of our own TCP requests
   std::string fatal_error_;  ///< configuration mismatch found on reconnect: no more retries
 
   mutable std::mutex command_mutex_;  ///< guards the fields below and stats_
   std::vector<double> command_nm_;
   double command_stamp_s_ = std::numeric_limits<double>::quiet_NaN();
+  double command_arrival_s_ = std::numeric_limits<double>::quiet_NaN();
   double accept_after_s_ = -std::numeric_limits<double>::infinity();
   bool want_enabled_ = false;
   bool estop_ = false;
   bool fault_reset_requested_ = false;
   LinkStatistics stats_;
+  CommandStatistics command_stats_;
   SampleWindow rtt_us_;
 };
 

@@ -55,6 +55,7 @@ class SimulatedDrive {
     state_machine_.raise_fault(error_code, latched_only);
   }
   void clear_fault_cause() { state_machine_.clear_fault_cause(); }
+  void leave_fault_without_reset() { state_machine_.leave_fault_without_reset(); }
   /// The echo register stops following the host counter (a stale-reply source).
   void set_echo_frozen(bool frozen) { echo_frozen_ = frozen; }
 
