@@ -62,9 +62,6 @@ const geometry::HeadConfig& head_config() {
 class TestMatchingSource final : public runtime::Component {
  public:
   static ComponentSpec spec() {
-    runtime::QosProfile latched;  // as decode publishes /depth/camera_info
-    latched.durability = runtime::Durability::transient_local;
-    latched.depth = 1;
     return {
         .type = "test_matching_source",
         .description = "tests: joint states at 1 kHz and depth images of the ken at 500 Hz",
@@ -74,8 +71,8 @@ class TestMatchingSource final : public runtime::Component {
         .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
                       runtime::port<msgs::sensor_msgs::JointState>("joints", "/head/joint_states"),
                       runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info"),
-                      runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
-                                                                   "/depth/camera_info", latched)},
+                      runtime::port<msgs::sensor_msgs::CameraInfo>(
+                          "camera_info", "/depth/camera_info", msg::camera_info_qos())},
         .subscribes = {}};
   }
   explicit TestMatchingSource(ComponentContext& ctx)

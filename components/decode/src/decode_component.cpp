@@ -67,10 +67,6 @@ class DecodeComponent final : public runtime::Component {
     points_qos.depth = 2;
     runtime::QosProfile keep_last_100;
     keep_last_100.depth = 100;
-    // Latched: a subscriber that starts later still gets the camera model before any image.
-    runtime::QosProfile latched;
-    latched.durability = runtime::Durability::transient_local;
-    latched.depth = 1;
     return {
         .type = "decode",
         .description =
@@ -102,8 +98,8 @@ class DecodeComponent final : public runtime::Component {
                       runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing",
                                                                  keep_last_100),
                       runtime::port<msgs::avs_msgs::DepthInfo>("info", "/depth/info", keep_last_4),
-                      runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
-                                                                   "/depth/camera_info", latched)},
+                      runtime::port<msgs::sensor_msgs::CameraInfo>(
+                          "camera_info", "/depth/camera_info", msg::camera_info_qos())},
         .subscribes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
                                                                    keep_last_4)},
         .default_mismatches = [] { return params().default_mismatches(); }};

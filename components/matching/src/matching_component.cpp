@@ -15,6 +15,7 @@
 #include "avs/geometry/head_kinematics.hpp"
 #include "avs/matching/joint_history.hpp"
 #include "avs/matching/pipeline.hpp"
+#include "avs/msg/camera_info.hpp"
 #include "avs/msg/camera_input.hpp"
 #include "avs/msg/convert.hpp"
 #include "avs/msg/depth_image.hpp"
@@ -35,9 +36,6 @@ class MatchingComponent final : public runtime::Component {
     keep_last_4.depth = 4;
     runtime::QosProfile keep_last_100;
     keep_last_100.depth = 100;
-    runtime::QosProfile latched;  // decode's /depth/camera_info
-    latched.durability = runtime::Durability::transient_local;
-    latched.depth = 1;
     runtime::QosProfile best_effort_2;
     best_effort_2.depth = 2;
     best_effort_2.reliability = runtime::Reliability::best_effort;
@@ -92,7 +90,7 @@ class MatchingComponent final : public runtime::Component {
              runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states"),
              runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info", keep_last_4),
              runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info", "/depth/camera_info",
-                                                          latched)},
+                                                          msg::camera_info_qos())},
         .default_mismatches = [] { return params().default_mismatches(); }};
   }
 

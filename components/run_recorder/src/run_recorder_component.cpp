@@ -57,9 +57,6 @@ geometry::Mesh load_model(const std::string& model) {
 runtime::ComponentSpec RunRecorderComponent::spec() {
   runtime::QosProfile deep;
   deep.depth = 100;
-  runtime::QosProfile latched;  // decode's /depth/camera_info
-  latched.durability = runtime::Durability::transient_local;
-  latched.depth = 1;
   return {
       .type = "run_recorder",
       .description =
@@ -88,7 +85,7 @@ runtime::ComponentSpec RunRecorderComponent::spec() {
           runtime::port<msgs::avs_msgs::GroundTruth>("ground_truth", "/sim/ground_truth", deep),
           runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
           runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info", "/depth/camera_info",
-                                                       latched),
+                                                       msg::camera_info_qos()),
           runtime::port<msgs::avs_msgs::TargetObservation>("target", "/target", deep),
           runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match", deep),
           runtime::port<msgs::geometry_msgs::PoseStamped>("pose_world", "/object/pose_world", deep),

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 
+#include "avs/msg/camera_info.hpp"
 #include "avs/msg/camera_input.hpp"
 #include "avs/msg/convert.hpp"
 #include "avs/msg/depth_image.hpp"
@@ -30,9 +31,6 @@ class TrackingComponent final : public runtime::Component {
   static ComponentSpec spec() {
     runtime::QosProfile keep_last_1;
     keep_last_1.depth = 1;
-    runtime::QosProfile latched;  // decode's /depth/camera_info
-    latched.durability = runtime::Durability::transient_local;
-    latched.depth = 1;
     runtime::QosProfile keep_last_4;
     keep_last_4.depth = 4;
     return {
@@ -54,8 +52,8 @@ class TrackingComponent final : public runtime::Component {
                       runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing")},
         .subscribes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image",
                                                                keep_last_4),
-                       runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
-                                                                    "/depth/camera_info", latched),
+                       runtime::port<msgs::sensor_msgs::CameraInfo>(
+                           "camera_info", "/depth/camera_info", msg::camera_info_qos()),
                        runtime::port<msgs::sensor_msgs::JointState>("joint_states",
                                                                     "/head/joint_states")},
         .default_mismatches = [] { return params().default_mismatches(); }};

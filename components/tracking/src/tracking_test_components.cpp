@@ -25,9 +25,6 @@ class TestDepthTarget final : public runtime::Component {
   static ComponentSpec spec() {
     runtime::QosProfile keep_last_4;
     keep_last_4.depth = 4;
-    runtime::QosProfile latched;
-    latched.durability = runtime::Durability::transient_local;
-    latched.depth = 1;
     return {
         .type = "test_depth_target",
         .description =
@@ -42,8 +39,8 @@ class TestDepthTarget final : public runtime::Component {
              ParamSpec::real("height_m", 0.0, -100.0, 100.0, "m", "sphere centre's y (image down)"),
              ParamSpec::real("start_s", 0.2, 0.0, std::nullopt, "s", "swing starts")},
         .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
-                      runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info",
-                                                                   "/depth/camera_info", latched)},
+                      runtime::port<msgs::sensor_msgs::CameraInfo>(
+                          "camera_info", "/depth/camera_info", msg::camera_info_qos())},
         .subscribes = {
             runtime::port<msgs::sensor_msgs::JointState>("head_state", "/sim/head_state")}};
   }

@@ -9,8 +9,15 @@
 
 #include "avs/geometry/camera_model.hpp"
 #include "avs/msg/type_support.hpp"
+#include "avs/runtime/qos.hpp"
 
 namespace avs::msg {
+
+/// QoS of /depth/camera_info, publisher and subscribers alike: reliable, transient local, keep
+/// last 1 (latched), so a consumer that starts later still gets the model before any image.
+inline runtime::QosProfile camera_info_qos() {
+  return *runtime::QosProfile::named("transient_local");
+}
 
 /// Fills `out` (its header's frame_id and the stamp are the caller's).
 void to_camera_info(const geometry::CameraModel& camera, msgs::sensor_msgs::CameraInfo& out);
