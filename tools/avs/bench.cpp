@@ -10,6 +10,15 @@ namespace avs::cli {
 
 namespace {
 
+#ifdef AVS_HAVE_BENCHMARKS
+constexpr bool kHaveBenchmarks = true;
+#else
+constexpr bool kHaveBenchmarks = false;
+#endif
+constexpr const char* kNoBenchmarks =
+    "this avs was built without benchmarks (AVS_BUILD_BENCHMARKS=OFF, as in the demo build); "
+    "configure with -DAVS_BUILD_BENCHMARKS=ON to build them";
+
 void print_table(const bench::Report& report) {
   std::printf("%s\n\n", report.title.c_str());
   std::printf("%-48s %12s   %-34s %12s %9s\n", "measure", "avs", "peer", "peer", "ratio");
@@ -46,9 +55,15 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--json", json, "print one JSON object (keys carry units)");
   // Everything after the name goes to the benchmark in the order given (--model FILE, ...).
   cmd->prefix_command();
-  cmd->footer("Arguments after NAME go to the benchmark in order, e.g. avs bench matching "
+  cmd->footer((kHaveBenchmarks ? std::string() : std::string("Note: ") + kNoBenchmarks + ".\n") +
+              "Arguments after NAME go to the benchmark in order, e.g. avs bench matching "
               "--model my.ply --json");
   cmd->callback([cmd] {
+    if (!kHaveBenchmarks) {
+      std::cerr << "avs bench: " << kNoBenchmarks << "\n";
+      exit_status() = name.empty() ? 0 : 2;
+      return;
+    }
     std::vector<std::string> args;
     for (const auto& word : cmd->remaining()) {
       if (word == "--json") {
