@@ -1,5 +1,5 @@
 // `avs report DIR` as wired by tools/avs/report_cmd.cpp (registered with AVS_REGISTER_COMMAND),
-// driven through CLI11 here without the whole avs program.
+// driven through the CLI11 facade (tools/avs/command.hpp) here without the whole avs program.
 #include <gtest/gtest.h>
 
 #include <CLI/CLI.hpp>
@@ -20,7 +20,7 @@ namespace avs::report {
 namespace {
 
 int run_cli(std::vector<std::string> words) {
-  CLI::App app{"avs"};
+  avs::cli::Command app{"avs"};
   app.require_subcommand(1);
   for (const auto& [name, adder] : avs::cli::registered_commands()) {
     if (name == "add_report_command") adder(app);

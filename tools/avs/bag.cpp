@@ -234,7 +234,7 @@ int run_repair(const std::string& file, std::string output) {
   return 0;
 }
 
-void add_bag_command(CLI::App& app) {
+void add_bag_command(Command& app) {
   auto* bag = app.add_subcommand(
       "bag", "Record topics to MCAP files, play them back, inspect and repair them");
   bag->require_subcommand(1);

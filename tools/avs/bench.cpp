@@ -47,7 +47,7 @@ void print_json(const bench::Report& report) {
 
 }  // namespace
 
-void add_bench_command(CLI::App& app) {
+void add_bench_command(Command& app) {
   auto* cmd = app.add_subcommand("bench", "Benchmarks against a peer measured in the same run");
   static std::string name;
   static bool json = false;

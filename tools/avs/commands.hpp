@@ -1,26 +1,27 @@
-// Each `avs` subcommand adds itself to the CLI11 app; one file per command family.
+// Each `avs` subcommand adds itself to the program's Command (command.hpp, a facade over
+// CLI11 so that the command files do not compile CLI11); one file per command family.
 #pragma once
 
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <CLI/CLI.hpp>
+#include "command.hpp"
 
 namespace avs::cli {
 
-void add_launch_command(CLI::App& app);
-void add_container_command(CLI::App& app);
-void add_check_command(CLI::App& app);
-void add_components_command(CLI::App& app);
-void add_topic_command(CLI::App& app);
-void add_bench_command(CLI::App& app);
-void add_demo_command(CLI::App& app);
+void add_launch_command(Command& app);
+void add_container_command(Command& app);
+void add_check_command(Command& app);
+void add_components_command(Command& app);
+void add_topic_command(Command& app);
+void add_bench_command(Command& app);
+void add_demo_command(Command& app);
 
 /// Subcommands in files of their own register themselves, so adding a command never edits
 /// main.cpp:  AVS_REGISTER_COMMAND(add_bag_command);  CLI11 lists commands in the order they
 /// are added; registered ones come after the built-in ones, sorted by function name.
-using CommandAdder = void (*)(CLI::App&);
+using CommandAdder = void (*)(Command&);
 struct CommandRegistration {
   CommandRegistration(const char* name, CommandAdder adder);
 };

@@ -22,7 +22,7 @@ std::filesystem::path default_run_dir(const std::string& name) {
 
 }  // namespace
 
-void add_demo_command(CLI::App& app) {
+void add_demo_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "demo",
       "Run the simulated closed loop (depth at 500 Hz, active tracking, model matching of the "

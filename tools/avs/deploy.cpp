@@ -22,7 +22,7 @@ std::optional<deploy::Deployment> load_deployment_or_report(const std::string& f
   return std::move(*r.deployment);
 }
 
-void add_deploy_command(CLI::App& app) {
+void add_deploy_command(Command& app) {
   auto* cmd = app.add_subcommand("deploy", "Deployments over several hosts (docs/deploy.md)");
   cmd->require_subcommand(1);
 

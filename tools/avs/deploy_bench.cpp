@@ -340,11 +340,11 @@ AVS_REGISTER_BENCH(transport, "transport",
                    "image latency between two processes: iceoryx shared memory vs UDP loopback",
                    transport_bench);
 
-void add_transport_peer_command(CLI::App& app) {
+void add_transport_peer_command(Command& app) {
   auto* cmd = app.add_subcommand("transport-peer", "internal: one side of avs bench transport");
   cmd->group("");  // hidden from avs --help
   static PeerOptions o;
-  cmd->add_option("role", o.role, "pub or sub")->required()->check(CLI::IsMember({"pub", "sub"}));
+  cmd->add_option("role", o.role, "pub or sub")->required()->check_member({"pub", "sub"});
   cmd->add_option("--count", o.count, "samples")->capture_default_str();
   cmd->add_option("--rate", o.rate_hz, "Hz")->capture_default_str();
   cmd->add_option("--bytes", o.bytes, "image bytes")->capture_default_str();

@@ -104,7 +104,7 @@ std::filesystem::path default_out_dir() {
 
 namespace {
 
-void add_experiments_command(CLI::App& app) {
+void add_experiments_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "experiments",
       "Run the paper's Sec. 7 experiments on the simulated closed loop: tracking, no_tracking, "
@@ -124,7 +124,7 @@ void add_experiments_command(CLI::App& app) {
   cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
   cmd->add_option("--time-scale", time_scale,
                   "multiply every scenario's simulated duration (short smoke runs: 0.2)")
-      ->check(CLI::Range(0.01, 10.0))
+      ->check_range(0.01, 10.0)
       ->capture_default_str();
   cmd->callback([] {
     std::vector<Experiment> chosen;

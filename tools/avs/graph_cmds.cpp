@@ -26,7 +26,7 @@ std::optional<graph::Graph> load_or_report(const std::string& file,
   return std::move(*result.graph);
 }
 
-void add_check_command(CLI::App& app) {
+void add_check_command(Command& app) {
   auto* cmd = app.add_subcommand("check", "Validate a YAML graph without starting anything");
   static std::string file;
   static std::vector<std::string> words;
@@ -45,7 +45,7 @@ void add_check_command(CLI::App& app) {
   });
 }
 
-void add_components_command(CLI::App& app) {
+void add_components_command(Command& app) {
   auto* cmd =
       app.add_subcommand("components", "List component types with their parameters and topics");
   static std::string only;
@@ -82,7 +82,7 @@ void add_components_command(CLI::App& app) {
   });
 }
 
-void add_container_command(CLI::App& app) {
+void add_container_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "container", "Run one container of a graph in this process (what `avs launch` starts)");
   static std::string file;

@@ -357,7 +357,7 @@ int run_graph_view(const Options& o) {
   return problems == 0 ? 0 : 3;
 }
 
-void add_graph_command(CLI::App& app) {
+void add_graph_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "graph",
       "Live graph: components and health, topics with rates, QoS mismatches named plainly");

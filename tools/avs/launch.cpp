@@ -404,7 +404,7 @@ int launch_graph(const std::string& file, const std::vector<std::string>& words,
   return run_launch(file, words, host);
 }
 
-void add_launch_command(CLI::App& app) {
+void add_launch_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "launch",
       "Start a YAML graph, or one host of a deployment (--host): a child process per container");

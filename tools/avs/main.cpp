@@ -1,5 +1,6 @@
 // avs: the command line. Subcommands live in their own files (launch.cpp, topic.cpp, ...).
 #include <iostream>
+#include <optional>
 
 #include "commands.hpp"
 
@@ -11,7 +12,7 @@ int& exit_status() {
 }  // namespace avs::cli
 
 int main(int argc, char** argv) {
-  CLI::App app{
+  avs::cli::Command app{
       "avs: active high-speed 3-D vision (Gray-code depth at 500 Hz, visual servoing, "
       "model matching) as a graph of components over DDS"};
   app.require_subcommand(1);
@@ -24,9 +25,7 @@ int main(int argc, char** argv) {
   avs::cli::add_bench_command(app);
   for (const auto& [name, adder] : avs::cli::registered_commands()) adder(app);
   try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (const std::optional<int> status = app.parse_or_explain(argc, argv)) return *status;
   } catch (const std::exception& e) {
     std::cerr << "avs: " << e.what() << "\n";
     return 1;

@@ -6,8 +6,6 @@
 #include <fstream>
 #include <iostream>
 
-#include <CLI/CLI.hpp>
-
 #include "commands.hpp"
 
 #if __has_include("avs/decode/png_io.hpp")
@@ -33,7 +31,7 @@ struct PatternsOptions {
 };
 
 #ifdef AVS_HAVE_DECODE
-int write_patterns(const PatternsOptions& o, CLI::App& cmd) {
+int write_patterns(const PatternsOptions& o, Command& cmd) {
   // Projector size and layout: the calibration's, unless given on the command line.
   decode::CodeLayout layout;
   int width = o.width;
@@ -102,7 +100,7 @@ int write_patterns(const PatternsOptions& o, CLI::App& cmd) {
 }
 #endif
 
-void add_patterns_command(CLI::App& app) {
+void add_patterns_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "patterns",
       "Write the Gray-code projector patterns (Eq. 1) as PNG files in projection order "

@@ -2,8 +2,6 @@
 // CSV data and prints the results table. The library is libs/report (docs/report.md).
 #include <iostream>
 
-#include <CLI/CLI.hpp>
-
 #include "commands.hpp"
 
 #if __has_include("avs/report/report.hpp")
@@ -15,7 +13,7 @@ namespace avs::cli {
 
 namespace {
 
-void add_report_command(CLI::App& app) {
+void add_report_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "report",
       "Make the report of a run folder (figures, index.html, summary.json) from its CSV data");

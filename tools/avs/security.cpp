@@ -215,7 +215,7 @@ int security_init(const std::string& dir_arg, const std::string& deployment_file
   return 0;
 }
 
-void add_security_command(CLI::App& app) {
+void add_security_command(Command& app) {
   auto* cmd = app.add_subcommand("security", "DDS Security for deployments (docs/deploy.md)");
   cmd->require_subcommand(1);
   auto* init = cmd->add_subcommand(

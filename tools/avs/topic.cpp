@@ -187,7 +187,7 @@ struct CommonOptions {
   long count = 0;         // 0 = unlimited
 };
 
-void add_common(CLI::App* cmd, CommonOptions& o, bool needs_topic) {
+void add_common(Command* cmd, CommonOptions& o, bool needs_topic) {
   if (needs_topic) cmd->add_option("topic", o.topic, "topic: /name, name or rt/name")->required();
   cmd->add_option("--domain", o.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")
       ->capture_default_str();
@@ -297,7 +297,7 @@ void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
 
 }  // namespace
 
-void add_topic_command(CLI::App& app) {
+void add_topic_command(Command& app) {
   auto* topic =
       app.add_subcommand("topic", "Inspect topics of running graphs (any process, any host)");
   topic->require_subcommand(1);

@@ -1,0 +1,125 @@
+// The CLI11 facade of command.hpp: the one file of the `avs` program that compiles CLI11.
+#include "command.hpp"
+
+#include <CLI/CLI.hpp>
+
+namespace avs::cli {
+
+Option* Option::required() {
+  option_->required();
+  return this;
+}
+
+Option* Option::capture_default_str() {
+  option_->capture_default_str();
+  return this;
+}
+
+Option* Option::check_member(std::vector<std::string> allowed) {
+  option_->check(CLI::IsMember(std::move(allowed)));
+  return this;
+}
+
+Option* Option::check_range(double min, double max) {
+  option_->check(CLI::Range(min, max));
+  return this;
+}
+
+Command::Command(std::string description)
+    : owned_(std::make_unique<CLI::App>(std::move(description))), app_(owned_.get()) {}
+
+Command::Command(CLI::App* app) : app_(app) {}
+
+Command::~Command() = default;
+
+Command* Command::add_subcommand(std::string name, std::string description) {
+  // The constructor is private: no make_unique.
+  subcommands_.push_back(std::unique_ptr<Command>(
+      new Command(app_->add_subcommand(std::move(name), std::move(description)))));
+  return subcommands_.back().get();
+}
+
+Option* Command::keep(CLI::Option* option) {
+  options_.push_back(std::make_unique<Option>(option));
+  return options_.back().get();
+}
+
+Option* Command::add_option(std::string name, std::string& value, std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, std::vector<std::string>& values,
+                            std::string description) {
+  return keep(app_->add_option(std::move(name), values, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, std::filesystem::path& value,
+                            std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, double& value, std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, int& value, std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, unsigned& value, std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, long& value, std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_option(std::string name, unsigned long& value, std::string description) {
+  return keep(app_->add_option(std::move(name), value, std::move(description)));
+}
+
+Option* Command::add_flag(std::string name, bool& value, std::string description) {
+  return keep(app_->add_flag(std::move(name), value, std::move(description)));
+}
+
+Command* Command::require_subcommand(int count) {
+  app_->require_subcommand(count);
+  return this;
+}
+
+Command* Command::callback(std::function<void()> run) {
+  app_->callback(std::move(run));
+  return this;
+}
+
+Command* Command::footer(std::string text) {
+  app_->footer(std::move(text));
+  return this;
+}
+
+Command* Command::group(std::string name) {
+  app_->group(std::move(name));
+  return this;
+}
+
+Command* Command::prefix_command() {
+  app_->prefix_command();
+  return this;
+}
+
+std::vector<std::string> Command::remaining() const { return app_->remaining(); }
+
+std::size_t Command::count(const std::string& name) const { return app_->count(name); }
+
+void Command::parse(int argc, const char* const* argv) { app_->parse(argc, argv); }
+
+std::optional<int> Command::parse_or_explain(int argc, const char* const* argv) {
+  try {
+    app_->parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app_->exit(e);
+  }
+  return std::nullopt;
+}
+
+}  // namespace avs::cli
