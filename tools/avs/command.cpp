@@ -25,6 +25,11 @@ Option* Option::check_range(double min, double max) {
   return this;
 }
 
+Option* Option::check_existing_file() {
+  option_->check(CLI::ExistingFile);
+  return this;
+}
+
 Command::Command(std::string description)
     : owned_(std::make_unique<CLI::App>(std::move(description))), app_(owned_.get()) {}
 

@@ -32,6 +32,8 @@ class Option {
   Option* check_member(std::vector<std::string> allowed);
   /// The value must lie in [min, max] (CLI::Range).
   Option* check_range(double min, double max);
+  /// The value must name an existing file (CLI::ExistingFile).
+  Option* check_existing_file();
 
  private:
   CLI::Option* option_;

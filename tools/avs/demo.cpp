@@ -43,7 +43,7 @@ void add_demo_command(Command& app) {
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
                   "decoder; the other components take it from /depth/camera_info")
-      ->check(CLI::ExistingFile);
+      ->check_existing_file();
   cmd->callback([] {
     run.scenario = "demo";
     run.tracking = !no_tracking;

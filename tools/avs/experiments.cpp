@@ -119,7 +119,7 @@ void add_experiments_command(Command& app) {
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
                   "decoder only; tracking, matching and the recorder take the camera model "
                   "from /depth/camera_info (default: the paper's sensor)")
-      ->check(CLI::ExistingFile);
+      ->check_existing_file();
   cmd->add_flag("--json", json, "print one JSON object keyed by scenario name on stdout");
   cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
   cmd->add_option("--time-scale", time_scale,

@@ -9,8 +9,6 @@
 #include <thread>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/dds.hpp"
@@ -74,7 +72,7 @@ int run_reset(const ResetOptions& o) {
   return 0;
 }
 
-void add_head_command(CLI::App& app) {
+void add_head_command(Command& app) {
   auto* head = app.add_subcommand("head", "Commands to the pan/tilt head's servo drive");
   head->require_subcommand(1);
   static ResetOptions options;
