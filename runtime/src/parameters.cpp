@@ -8,24 +8,9 @@
 namespace avs::runtime {
 namespace {
 
-/// Shortest text that reads back as the same double ("0.1", "10000", "1e-06").
-std::string format_number(double v) {
-  char buf[64];
-  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  if (ec != std::errc()) return std::to_string(v);
-  return std::string(buf, end);
-}
-
 /// " in [0.1, 10000] Hz", " >= 0 m", "" (no bounds, no unit).
-std::string range_text(const ParamSpec& spec) {
-  std::string r;
-  if (spec.min && spec.max) {
-    r = " in [" + format_number(*spec.min) + ", " + format_number(*spec.max) + "]";
-  } else if (spec.min) {
-    r = " >= " + format_number(*spec.min);
-  } else if (spec.max) {
-    r = " <= " + format_number(*spec.max);
-  }
+std::string bounds_and_unit(const ParamSpec& spec) {
+  std::string r = range_text(spec.min, spec.max);
   if (!spec.unit.empty()) r += " " + spec.unit;
   return r;
 }
@@ -55,6 +40,20 @@ std::string join_quoted(const std::vector<std::string>& items) {
 }
 
 }  // namespace
+
+std::string format_number(double v) {
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  if (ec != std::errc()) return std::to_string(v);
+  return std::string(buf, end);
+}
+
+std::string range_text(std::optional<double> min, std::optional<double> max) {
+  if (min && max) return " in [" + format_number(*min) + ", " + format_number(*max) + "]";
+  if (min) return " >= " + format_number(*min);
+  if (max) return " <= " + format_number(*max);
+  return "";
+}
 
 std::string to_string(ParamType type) {
   switch (type) {
@@ -169,7 +168,7 @@ std::string ParamSpec::check(const ParamValue& value) const {
       if (got != ParamType::boolean) return "expected true or false, got " + got_text(value);
       return {};
     case ParamType::integer: {
-      const std::string expected = "expected an integer" + range_text(*this);
+      const std::string expected = "expected an integer" + bounds_and_unit(*this);
       if (got != ParamType::integer) return expected + ", got " + got_text(value);
       if (!in_range(*this, static_cast<double>(std::get<std::int64_t>(value)))) {
         return expected + ", got " + got_text(value);
@@ -177,7 +176,7 @@ std::string ParamSpec::check(const ParamValue& value) const {
       return {};
     }
     case ParamType::real: {
-      const std::string expected = "expected a number" + range_text(*this);
+      const std::string expected = "expected a number" + bounds_and_unit(*this);
       double v = 0.0;
       if (got == ParamType::real) {
         v = std::get<double>(value);
@@ -203,7 +202,7 @@ std::string ParamSpec::check(const ParamValue& value) const {
       return "expected one of " + join_quoted(choices) + ", got " + got_text(value);
     }
     case ParamType::real_list: {
-      const std::string expected = "expected a list of numbers" + range_text(*this);
+      const std::string expected = "expected a list of numbers" + bounds_and_unit(*this);
       if (got != ParamType::real_list) return expected + ", got " + got_text(value);
       const auto& list = std::get<std::vector<double>>(value);
       for (std::size_t i = 0; i < list.size(); ++i) {

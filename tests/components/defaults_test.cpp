@@ -25,7 +25,7 @@ TEST(ComponentDefaults, BoundParametersHaveTheirCoreConfigsDefaults) {
     }
   }
   // The components whose cores have a Config with defaults bind their parameters to it.
-  for (const char* type : {"tracking", "matching", "decode"}) {
+  for (const char* type : {"tracking", "matching", "decode", "servo_drive"}) {
     EXPECT_TRUE(bound.contains(type)) << type << " keeps a second list of defaults";
   }
 }

@@ -73,6 +73,11 @@ TEST(Convert, JointsAreFoundByNameAndNameListsAreChecked) {
   EXPECT_THROW(parse_name_list("pan", 2, "joint_names"), std::invalid_argument);
   EXPECT_THROW(parse_name_list("pan,", 2, "joint_names"), std::invalid_argument);
   EXPECT_THROW(parse_name_list("a,b,c", 2, "joint_names"), std::invalid_argument);
+  EXPECT_EQ(parse_name_list(" pan ,\ttilt", 2, "joint_names"),
+            (std::vector<std::string>{"pan", "tilt"}));
+  EXPECT_EQ(parse_name_list("a,b,c", 0, "axis_names"), (std::vector<std::string>{"a", "b", "c"}));
+  EXPECT_THROW(parse_name_list("", 0, "axis_names"), std::invalid_argument);
+  EXPECT_THROW(parse_name_list("a, ,c", 0, "axis_names"), std::invalid_argument);
 }
 
 }  // namespace

@@ -60,10 +60,7 @@ void add_components_command(Command& app) {
         std::cout << "  param " << p.name << " (" << runtime::to_string(p.type)
                   << ") = " << runtime::to_string(p.default_value);
         if (!p.unit.empty()) std::cout << " " << p.unit;
-        if (p.min || p.max) {
-          std::cout << " in [" << (p.min ? std::to_string(*p.min) : "-inf") << ", "
-                    << (p.max ? std::to_string(*p.max) : "inf") << "]";
-        }
+        std::cout << runtime::range_text(p.min, p.max);
         std::cout << "  " << p.description << "\n";
       }
       for (const auto& p : c->spec.publishes) {

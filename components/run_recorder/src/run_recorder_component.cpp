@@ -144,11 +144,8 @@ RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Com
       });
   ctx.subscribe<msgs::sensor_msgs::CameraInfo>(
       "camera_info", [this](runtime::SamplePtr<msgs::sensor_msgs::CameraInfo> m) {
-        std::string why;
-        if (const auto camera = msg::from_camera_info(*m, &why)) {
-          assembler_->set_camera(*camera);  // the in-view test and the centroid's origin
-        } else {
-          log().warn(why, ": ignored");
+        if (camera_.update(*m)) {
+          assembler_->set_camera(*camera_.model());  // the in-view test, the centroid's origin
         }
       });
   ctx.subscribe<msgs::sensor_msgs::Image>(
@@ -213,6 +210,10 @@ void RunRecorderComponent::on_deactivate() {
   }
 }
 
+std::vector<std::pair<std::string, std::string>> RunRecorderComponent::diagnostic_values() const {
+  return {rejected_.diagnostic()};
+}
+
 void RunRecorderComponent::on_depth(const msgs::sensor_msgs::Image& image) {
   const std::int64_t stamp = stamp_ns(image.header.stamp);
   assembler_->on_depth(stamp);
@@ -235,8 +236,8 @@ void RunRecorderComponent::write_depth_snapshot(const msgs::sensor_msgs::Image& 
   const double t_s = runtime::from_ros_time(image.header.stamp).seconds();
   if (runtime::get_string(image.encoding) != "32FC1" || image.step != image.width * 4 ||
       static_cast<std::uint64_t>(image.step) * image.height > image.data._length) {
-    log().warn("depth snapshot skipped: expected packed 32FC1, got '",
-               runtime::get_string(image.encoding), "'");
+    rejected_.reject("depth snapshot skipped: expected packed 32FC1, got '" +
+                     std::string(runtime::get_string(image.encoding)) + "'");
     depth_snapshot_taken_ = true;
     return;
   }
@@ -264,7 +265,7 @@ void RunRecorderComponent::on_scene_points(const msgs::sensor_msgs::PointCloud2&
   std::string why;
   const auto points = msg::read_xyz_cloud(cloud, &why);
   if (!points) {
-    log().warn("cloud snapshot skipped: ", why);
+    rejected_.reject("cloud snapshot skipped: " + why);
     next_cloud_ = cloud_times_s_.size();
     return;
   }

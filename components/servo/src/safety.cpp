@@ -1,5 +1,7 @@
 #include "avs/servo/safety.hpp"
 
+#include "avs/servo/plant.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -16,6 +18,32 @@ bool envelope_enabled(const AxisSafetyConfig& config) {
 }
 
 }  // namespace
+
+namespace {
+
+AxisSafetyConfig safety_of_plant(const AxisPlantConfig& plant, double soft_limit_rad,
+                                 double brake_gain_nm_s_per_rad) {
+  AxisSafetyConfig c;
+  c.configured_max_torque_nm = plant.max_motor_torque_nm;
+  c.motor_max_torque_nm = plant.max_motor_torque_nm;
+  c.soft_lower_rad = -soft_limit_rad;
+  c.soft_upper_rad = soft_limit_rad;
+  c.brake_gain_nm_s_per_rad = brake_gain_nm_s_per_rad;
+  c.output_inertia_kg_m2 = plant.inertia_kgm2;
+  c.gear_ratio = plant.gear_ratio;
+  c.gear_efficiency = plant.efficiency;
+  return c;
+}
+
+}  // namespace
+
+AxisSafetyConfig pan_safety_config() {
+  return safety_of_plant(pan_plant_config(), 3.0, 0.05);
+}
+
+AxisSafetyConfig tilt_safety_config() {
+  return safety_of_plant(tilt_plant_config(), 1.4, 0.01);
+}
 
 std::string describe_safety_reasons(std::uint32_t reasons) {
   static constexpr std::pair<std::uint32_t, const char*> names[] = {

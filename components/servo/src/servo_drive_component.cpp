@@ -18,12 +18,14 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <sstream>
 #include <thread>
 
 #include <yaml-cpp/yaml.h>
 
+#include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/config_params.hpp"
+#include "avs/servo/amplifier_server.hpp"
 #include "avs/servo/drive_client.hpp"
 #include "avs/servo/plant.hpp"
 #include "avs/servo/register_map_yaml.hpp"
@@ -35,18 +37,6 @@ using runtime::ComponentSpec;
 using runtime::ParamSpec;
 
 namespace {
-
-std::vector<std::string> split_names(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    item.erase(0, item.find_first_not_of(" \t"));
-    item.erase(item.find_last_not_of(" \t") + 1);
-    if (!item.empty()) out.push_back(item);
-  }
-  return out;
-}
 
 double element(const std::vector<double>& list, std::size_t i, const std::string& param) {
   if (i >= list.size()) {
@@ -89,12 +79,6 @@ std::vector<RegisterMap> load_maps(const std::string& path, const std::vector<st
 class ServoDrive final : public runtime::Component {
  public:
   static ComponentSpec spec() {
-    // Defaults from the cores (one fact in one place): safety rules and the plant model.
-    const CommandFreshness freshness;
-    const AxisSafetyConfig safety;
-    const DriveClientConfig client;
-    const AxisPlantConfig pan_plant = pan_plant_config();
-    const AxisPlantConfig tilt_plant = tilt_plant_config();
     using runtime::QosProfile;
     QosProfile keep_last_1;
     keep_last_1.depth = 1;
@@ -105,83 +89,48 @@ class ServoDrive final : public runtime::Component {
     QosProfile estop_qos;
     estop_qos.depth = 1;
     estop_qos.durability = runtime::Durability::transient_local;
+    const AxisSafetyConfig any_axis;
     return {
         .type = "servo_drive",
         .description =
             "servo amplifiers over Modbus TCP/RTU (CiA 402, torque mode) with the "
             "host-side safety rules; publishes joint states and drive status",
-        .parameters =
-            {ParamSpec::string("transport", "tcp", "Modbus transport", {"tcp", "rtu"}),
-             ParamSpec::string("host", "127.0.0.1", "TCP: amplifier address"),
-             ParamSpec::integer("port", 1502, 1, 65535, "", "TCP: amplifier port"),
+        .parameters = params().specs_with(
+            {ParamSpec::integer("port", sim_amplifier_default_port, 1, 65535, "",
+                                "TCP: amplifier port (default: sim_amplifier's)"),
              ParamSpec::string("axis_names", "pan,tilt", "comma-separated joint names, in order"),
              ParamSpec::real_list("unit_ids", {1, 2}, "", "Modbus unit id per axis"),
-             ParamSpec::string("rtu_device", "/dev/ttyUSB0", "RTU: serial device"),
-             ParamSpec::integer("rtu_baud", 115200, 1200, 12000000, "Bd", "RTU: baud rate"),
-             ParamSpec::string("rtu_parity", "E", "RTU: parity", {"N", "E", "O"}),
-             ParamSpec::integer("rtu_data_bits", 8, 7, 8, "", "RTU: data bits"),
-             ParamSpec::integer("rtu_stop_bits", 1, 1, 2, "", "RTU: stop bits"),
-             ParamSpec::boolean("rtu_rs485", true, "RTU: RS-485 serial mode"),
-             ParamSpec::string("rtu_rts", "none", "RTU: RTS direction control",
-                               {"none", "up", "down"}),
-             ParamSpec::integer("rtu_rts_delay_us", -1, -1, 1000000, "us",
-                                "RTU: RTS delay (-1 = libmodbus default)"),
-             ParamSpec::real("rtu_turnaround_s", 0.0005, 0.0, 1.0, "s",
-                             "RTU: drive reply delay, used by the link budget check"),
              ParamSpec::string("register_map", "",
                                "register map YAML file (docs/servo.md); empty = the simulated "
                                "amplifier's map for pan/tilt"),
-             ParamSpec::real("cycle_rate_hz", 1000.0, 1.0, 10000.0, "Hz", "cyclic exchange rate"),
              ParamSpec::real("response_timeout_s", 0.0, 0.0, 10.0, "s",
                              "Modbus response timeout (wall time); 0 = auto: 0.4 x period / axes "
                              "in wall time, 1 s in sim time (waiting costs no simulated time)"),
-             ParamSpec::boolean("use_write_read_0x17", true,
-                                "one 0x17 write+read per axis, else 0x10 + 0x03"),
-             ParamSpec::real("command_timeout_s", freshness.timeout_s, 0.0001, 10.0, "s",
-                             "torque commands whose stamp or arrival is older than this -> "
-                             "zero torque"),
-             ParamSpec::real("command_future_tolerance_s", freshness.future_tolerance_s, 0.0,
-                             1.0, "s",
-                             "torque commands stamped later than their arrival by more than "
-                             "this are rejected and counted (sender clock ahead)"),
-             ParamSpec::integer("fault_clear_stable_cycles", client.fault_clear_stable_cycles, 1,
-                                100000, "",
-                                "a drive fault latches zero torque until a reset request and "
-                                "this many consecutive cycles of Operation enabled"),
-             ParamSpec::real_list("max_torque_nm", {5.73, 0.9555}, "N m",
-                                  "configured motor torque limit per axis (also written to the "
-                                  "drive's max_torque)"),
-             ParamSpec::real_list("motor_max_torque_nm", {5.73, 0.9555}, "N m",
-                                  "motor peak torque per axis (Table 3)"),
-             ParamSpec::real_list("soft_lower_rad", {-3.0, -1.4}, "rad",
-                                  "soft lower position limit per axis"),
-             ParamSpec::real_list("soft_upper_rad", {3.0, 1.4}, "rad",
-                                  "soft upper position limit per axis"),
-             ParamSpec::real("brake_zone_rad", 0.1, 0.0, 10.0, "rad",
+             // Per axis (pan, tilt): the head's safety rules, safety.hpp.
+             per_axis("max_torque_nm", &AxisSafetyConfig::configured_max_torque_nm, "N m",
+                      "configured motor torque limit per axis (also written to the drive's "
+                      "max_torque)"),
+             per_axis("motor_max_torque_nm", &AxisSafetyConfig::motor_max_torque_nm, "N m",
+                      "motor peak torque per axis (Table 3)"),
+             per_axis("soft_lower_rad", &AxisSafetyConfig::soft_lower_rad, "rad",
+                      "soft lower position limit per axis"),
+             per_axis("soft_upper_rad", &AxisSafetyConfig::soft_upper_rad, "rad",
+                      "soft upper position limit per axis"),
+             ParamSpec::real("brake_zone_rad", any_axis.brake_zone_rad, 0.0, 10.0, "rad",
                              "braking zone inside each soft limit"),
-             ParamSpec::real_list("brake_gain_nm_s_per_rad", {0.05, 0.01}, "N m s/rad",
-                                  "braking torque per output rad/s toward a nearby limit"),
-             ParamSpec::real_list("output_inertia_kg_m2",
-                                  {pan_plant.inertia_kgm2, tilt_plant.inertia_kgm2}, "kg m2",
-                                  "output-side inertia J_eq per axis, for the soft-limit "
-                                  "velocity envelope (0 = no envelope)"),
-             ParamSpec::real_list("gear_ratio", {pan_plant.gear_ratio, tilt_plant.gear_ratio},
-                                  "", "motor turns per output turn, per axis (envelope)"),
-             ParamSpec::real_list("gear_efficiency",
-                                  {pan_plant.efficiency, tilt_plant.efficiency}, "",
-                                  "gear efficiency per axis (envelope)"),
-             ParamSpec::real("envelope_brake_fraction", safety.envelope_brake_fraction, 0.0, 1.0,
+             per_axis("brake_gain_nm_s_per_rad", &AxisSafetyConfig::brake_gain_nm_s_per_rad,
+                      "N m s/rad", "braking torque per output rad/s toward a nearby limit"),
+             per_axis("output_inertia_kg_m2", &AxisSafetyConfig::output_inertia_kg_m2, "kg m2",
+                      "output-side inertia J_eq per axis, for the soft-limit velocity envelope "
+                      "(0 = no envelope)"),
+             per_axis("gear_ratio", &AxisSafetyConfig::gear_ratio, "",
+                      "motor turns per output turn, per axis (envelope)"),
+             per_axis("gear_efficiency", &AxisSafetyConfig::gear_efficiency, "",
+                      "gear efficiency per axis (envelope)"),
+             ParamSpec::real("envelope_brake_fraction", any_axis.envelope_brake_fraction, 0.0, 1.0,
                              "",
                              "share of the full braking deceleration the velocity envelope "
                              "plans with (the rest is margin); 0 = no envelope"),
-             ParamSpec::string("estop_action", "disable_operation", "what an e-stop does",
-                               {"disable_operation", "quick_stop"}),
-             ParamSpec::boolean("auto_fault_reset", false,
-                                "reset drive faults automatically once their cause is gone"),
-             ParamSpec::real("reconnect_backoff_initial_s", 0.005, 0.0001, 60.0, "s",
-                             "first reconnect delay after a link fault (doubles)"),
-             ParamSpec::real("reconnect_backoff_max_s", 0.5, 0.0001, 600.0, "s",
-                             "reconnect delay bound"),
              ParamSpec::boolean("own_thread", false,
                                 "cycle on a thread of its own (wall time only); false = "
                                 "container timer (required in sim time)"),
@@ -190,7 +139,7 @@ class ServoDrive final : public runtime::Component {
              ParamSpec::real("status_rate_hz", 10.0, 0.1, 1000.0, "Hz", "/head/drive_status rate"),
              ParamSpec::string("report_dir", "",
                                "tests: write <name>.csv (every cycle) and <name>.yaml (summary) "
-                               "here on deactivate; empty = none")},
+                               "here on deactivate; empty = none")}),
         .publishes = {runtime::port<msgs::sensor_msgs::JointState>("joint_states",
                                                                    "/head/joint_states"),
                       runtime::port<msgs::avs_msgs::DriveStatus>(
@@ -199,7 +148,70 @@ class ServoDrive final : public runtime::Component {
                            "torque_command", "/head/torque_command", keep_last_1),
                        runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
                        runtime::port<msgs::std_msgs::Empty>("fault_reset", "/head/fault_reset",
-                                                            reset_qos)}};
+                                                            reset_qos)},
+        .default_mismatches = [] { return params().default_mismatches(); }};
+  }
+
+  /// Parameters bound to DriveClientConfig (its defaults are the parameters').
+  static const runtime::ConfigParams<DriveClientConfig>& params() {
+    static const auto p =
+        runtime::ConfigParams<DriveClientConfig>()
+            .choice("transport", AVS_FIELD(transport),
+                    std::vector<std::pair<std::string, Transport>>{{"tcp", Transport::tcp},
+                                                                   {"rtu", Transport::rtu}},
+                    "Modbus transport")
+            .string("host", AVS_FIELD(tcp.host), "TCP: amplifier address")
+            .string("rtu_device", AVS_FIELD(rtu.device), "RTU: serial device")
+            .integer("rtu_baud", AVS_FIELD(rtu.line.baud), 1200, 12000000, "Bd", "RTU: baud rate")
+            .choice("rtu_parity", AVS_FIELD(rtu.line.parity),
+                    std::vector<std::pair<std::string, char>>{{"N", 'N'}, {"E", 'E'}, {"O", 'O'}},
+                    "RTU: parity")
+            .integer("rtu_data_bits", AVS_FIELD(rtu.line.data_bits), 7, 8, "", "RTU: data bits")
+            .integer("rtu_stop_bits", AVS_FIELD(rtu.line.stop_bits), 1, 2, "", "RTU: stop bits")
+            .boolean("rtu_rs485", AVS_FIELD(rtu.rs485), "RTU: RS-485 serial mode")
+            .choice("rtu_rts", AVS_FIELD(rtu.rts),
+                    std::vector<std::pair<std::string, int>>{{"none", MODBUS_RTU_RTS_NONE},
+                                                             {"up", MODBUS_RTU_RTS_UP},
+                                                             {"down", MODBUS_RTU_RTS_DOWN}},
+                    "RTU: RTS direction control")
+            .integer("rtu_rts_delay_us", AVS_FIELD(rtu.rts_delay_us), -1, 1000000, "us",
+                     "RTU: RTS delay (-1 = libmodbus default)")
+            .real("rtu_turnaround_s", AVS_FIELD(rtu.drive_turnaround_s), 0.0, 1.0, "s",
+                  "RTU: drive reply delay, used by the link budget check")
+            .real("cycle_rate_hz", AVS_FIELD(cycle_rate_hz), 1.0, 10000.0, "Hz",
+                  "cyclic exchange rate")
+            .boolean("use_write_read_0x17", AVS_FIELD(use_write_read_0x17),
+                     "one 0x17 write+read per axis, else 0x10 + 0x03")
+            .real("command_timeout_s", AVS_FIELD(command_freshness.timeout_s), 0.0001, 10.0, "s",
+                  "torque commands whose stamp or arrival is older than this -> zero torque")
+            .real("command_future_tolerance_s", AVS_FIELD(command_freshness.future_tolerance_s),
+                  0.0, 1.0, "s",
+                  "torque commands stamped later than their arrival by more than this are "
+                  "rejected and counted (sender clock ahead)")
+            .integer("fault_clear_stable_cycles", AVS_FIELD(fault_clear_stable_cycles), 1, 100000,
+                     "",
+                     "a drive fault latches zero torque until a reset request and this many "
+                     "consecutive cycles of Operation enabled")
+            .choice("estop_action", AVS_FIELD(estop_action),
+                    std::vector<std::pair<std::string, EstopAction>>{
+                        {"disable_operation", EstopAction::disable_operation},
+                        {"quick_stop", EstopAction::quick_stop}},
+                    "what an e-stop does")
+            .boolean("auto_fault_reset", AVS_FIELD(auto_fault_reset),
+                     "reset drive faults automatically once their cause is gone")
+            .real("reconnect_backoff_initial_s", AVS_FIELD(reconnect_backoff_initial_s), 0.0001,
+                  60.0, "s", "first reconnect delay after a link fault (doubles)")
+            .real("reconnect_backoff_max_s", AVS_FIELD(reconnect_backoff_max_s), 0.0001, 600.0, "s",
+                  "reconnect delay bound");
+    return p;
+  }
+
+  /// A per-axis list parameter whose default is the field of the pan and the tilt axis.
+  static ParamSpec per_axis(std::string name, double AxisSafetyConfig::*field, std::string unit,
+                            std::string description) {
+    return ParamSpec::real_list(std::move(name),
+                                {pan_safety_config().*field, tilt_safety_config().*field},
+                                std::move(unit), std::move(description));
   }
 
   explicit ServoDrive(ComponentContext& ctx)
@@ -271,36 +283,11 @@ class ServoDrive final : public runtime::Component {
 
  private:
   DriveClientConfig make_config(ComponentContext& ctx) {
-    DriveClientConfig c;
-    c.transport = ctx.param<std::string>("transport") == "rtu" ? Transport::rtu : Transport::tcp;
-    c.tcp.host = ctx.param<std::string>("host");
+    DriveClientConfig c = params().make(ctx.parameters());
     c.tcp.port = ctx.param<int>("port");
-    c.rtu.device = ctx.param<std::string>("rtu_device");
-    c.rtu.line.baud = ctx.param<int>("rtu_baud");
-    c.rtu.line.parity = ctx.param<std::string>("rtu_parity")[0];
-    c.rtu.line.data_bits = ctx.param<int>("rtu_data_bits");
-    c.rtu.line.stop_bits = ctx.param<int>("rtu_stop_bits");
-    c.rtu.rs485 = ctx.param<bool>("rtu_rs485");
-    const std::string rts = ctx.param<std::string>("rtu_rts");
-    c.rtu.rts = rts == "up"     ? MODBUS_RTU_RTS_UP
-                : rts == "down" ? MODBUS_RTU_RTS_DOWN
-                                : MODBUS_RTU_RTS_NONE;
-    c.rtu.rts_delay_us = ctx.param<int>("rtu_rts_delay_us");
-    c.rtu.drive_turnaround_s = ctx.param<double>("rtu_turnaround_s");
-    c.cycle_rate_hz = ctx.param<double>("cycle_rate_hz");
-    c.command_freshness.timeout_s = ctx.param<double>("command_timeout_s");
-    c.command_freshness.future_tolerance_s = ctx.param<double>("command_future_tolerance_s");
-    c.fault_clear_stable_cycles = ctx.param<int>("fault_clear_stable_cycles");
-    c.use_write_read_0x17 = ctx.param<bool>("use_write_read_0x17");
-    c.reconnect_backoff_initial_s = ctx.param<double>("reconnect_backoff_initial_s");
-    c.reconnect_backoff_max_s = ctx.param<double>("reconnect_backoff_max_s");
-    c.estop_action = ctx.param<std::string>("estop_action") == "quick_stop"
-                         ? EstopAction::quick_stop
-                         : EstopAction::disable_operation;
-    c.auto_fault_reset = ctx.param<bool>("auto_fault_reset");
 
-    const std::vector<std::string> names = split_names(ctx.param<std::string>("axis_names"));
-    if (names.empty()) throw ConfigError("servo_drive: axis_names is empty");
+    const std::vector<std::string> names =
+        msg::parse_name_list(ctx.param<std::string>("axis_names"), 0, "axis_names");
     const auto unit_ids = ctx.param<std::vector<double>>("unit_ids");
     const auto max_torque = ctx.param<std::vector<double>>("max_torque_nm");
     const auto motor_max = ctx.param<std::vector<double>>("motor_max_torque_nm");

@@ -35,6 +35,10 @@ struct Event {
 class SimAmplifier final : public runtime::Component {
  public:
   static ComponentSpec spec() {
+    // Defaults from the cores: the server's and the two drives' configs.
+    const AmplifierServerConfig server;
+    const SimulatedDriveConfig pan = pan_drive_config();
+    const SimulatedDriveConfig tilt = tilt_drive_config();
     return {
         .type = "sim_amplifier",
         .description =
@@ -42,21 +46,27 @@ class SimAmplifier final : public runtime::Component {
             "(Modbus TCP server, unit 1 pan, unit 2 tilt), stepped on the container "
             "clock; fault injection schedule for tests",
         .parameters =
-            {ParamSpec::string("bind_address", "127.0.0.1", "address the Modbus server binds"),
-             ParamSpec::integer("port", 1502, 1, 65535, "", "Modbus TCP port"),
-             ParamSpec::integer("pan_unit_id", 1, 1, 247, "", "Modbus unit id of the pan drive"),
-             ParamSpec::integer("tilt_unit_id", 2, 1, 247, "", "Modbus unit id of the tilt drive"),
-             ParamSpec::real("plant_rate_hz", 1000.0, 100.0, 100000.0, "Hz",
+            {ParamSpec::string("bind_address", server.bind_address,
+                               "address the Modbus server binds"),
+             ParamSpec::integer("port", sim_amplifier_default_port, 1, 65535, "",
+                                "Modbus TCP port"),
+             ParamSpec::integer("pan_unit_id", pan.unit_id, 1, 247, "",
+                                "Modbus unit id of the pan drive"),
+             ParamSpec::integer("tilt_unit_id", tilt.unit_id, 1, 247, "",
+                                "Modbus unit id of the tilt drive"),
+             ParamSpec::real("plant_rate_hz", 1.0 / server.step_period_s, 100.0, 100000.0, "Hz",
                              "drive/plant stepping rate on the container clock (the plant "
                              "integrates with sub-steps <= 0.1 ms inside each step)"),
              ParamSpec::real("publish_rate_hz", 1000.0, 1.0, 100000.0, "Hz",
                              "/sim/head_state rate (at most the plant rate)"),
-             ParamSpec::real("watchdog_timeout_s", 0.002, 0.0, 10.0, "s",
+             ParamSpec::real("watchdog_timeout_s", pan.watchdog_timeout_s, 0.0, 10.0, "s",
                              "drive-side watchdog: no command for this long -> fault 0x8130 "
                              "(0 = off)"),
-             ParamSpec::real("initial_pan_rad", 0.0, -3.2, 3.2, "rad", "pan angle at start"),
-             ParamSpec::real("initial_tilt_rad", 0.0, -1.6, 1.6, "rad", "tilt angle at start"),
-             ParamSpec::real("tilt_gravity_nm", 0.0, 0.0, 10.0, "N m",
+             ParamSpec::real("initial_pan_rad", pan.initial_q_rad, -3.2, 3.2, "rad",
+                             "pan angle at start"),
+             ParamSpec::real("initial_tilt_rad", tilt.initial_q_rad, -1.6, 1.6, "rad",
+                             "tilt angle at start"),
+             ParamSpec::real("tilt_gravity_nm", tilt.plant.gravity_nm, 0.0, 10.0, "N m",
                              "m g l of an unbalanced tilt axis (0 = balanced)"),
              ParamSpec::real("silent_from_s", -1.0, -1.0, std::nullopt, "s",
                              "fault injection: stop answering requests at this container time "

@@ -109,6 +109,11 @@ class SimScene final : public runtime::Component {
     keep_last_4.depth = 4;
     runtime::QosProfile keep_last_100;
     keep_last_100.depth = 100;
+    // The scene's own defaults, quoted in the descriptions of the overrides (written once, in
+    // the cores).
+    const SimulatorConfig sim;
+    const LateralSwingConfig swing;
+    const auto text = [](double v) { return runtime::to_string(runtime::ParamValue(v)); };
     return {
         .type = "sim_scene",
         .description =
@@ -130,23 +135,28 @@ class SimScene final : public runtime::Component {
                                {"", "static", "swing", "manipulator"}),
              ParamSpec::real("swing_speed_m_s", 0.0, 0.0, 20.0, "m/s",
                              "peak speed of a lateral swing (section 7.1); 0: as in the scene "
-                             "(lateral_swing default 1.0)"),
+                             "(lateral_swing default " +
+                                 text(swing.peak_speed_mps) + ")"),
              ParamSpec::real("swing_amplitude_m", 0.0, 0.0, 2.0, "m",
-                             "amplitude of a lateral swing; 0: as in the scene (default 0.25)"),
+                             "amplitude of a lateral swing; 0: as in the scene (default " +
+                                 text(swing.amplitude_m) + ")"),
              ParamSpec::real("distance_m", 0.0, 0.0, 10.0, "m",
                              "shift the target along world X so that it starts this far from "
                              "the pan axis; 0: as in the scene"),
              ParamSpec::integer("seed", -1, -1, 1e15, "",
                                 "sensor noise seed (sensor.noise_seed); -1: as in the scene "
-                                "(default 1)"),
+                                "(default " +
+                                    std::to_string(sim.renderer.noise_seed) + ")"),
              ParamSpec::real("noise_sigma_dn", -1.0, -1.0, 100.0, "DN",
-                             "sensor noise sigma; -1: as in the scene (default 2.0)"),
+                             "sensor noise sigma; -1: as in the scene (default " +
+                                 text(sim.renderer.noise_sigma_dn) + ")"),
              ParamSpec::integer("motion_blur_samples", 0, 0, 64, "",
                                 "poses averaged over the exposure; 0: as in the scene "
-                                "(default 1 = no blur)"),
+                                "(default " +
+                                    std::to_string(sim.motion_blur_samples) + "; 1 = no blur)"),
              ParamSpec::real("frame_rate_hz", 0.0, 0.0, 100000.0, "Hz",
-                             "frame rate; 0: the scene's sensor.frame_rate_hz (default 1000, "
-                             "section 3.1)"),
+                             "frame rate; 0: the scene's sensor.frame_rate_hz (default " +
+                                 text(sim.frame_rate_hz) + ", section 3.1)"),
              ParamSpec::real("start_time_s", 0.0, std::nullopt, std::nullopt, "s",
                              "scene time of frame 0: frame k shows the scene at "
                              "start_time_s + k / frame_rate_hz"),

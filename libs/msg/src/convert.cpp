@@ -124,19 +124,25 @@ std::optional<JointReading> find_joint(const msgs::sensor_msgs::JointState& stat
 std::vector<std::string> parse_name_list(std::string_view list, std::size_t count,
                                          std::string_view parameter) {
   std::vector<std::string> names;
+  bool empty = false;
   std::size_t start = 0;
   for (;;) {
     const std::size_t comma = list.find(',', start);
-    names.emplace_back(list.substr(start, comma == std::string_view::npos ? comma : comma - start));
+    std::string_view name =
+        list.substr(start, comma == std::string_view::npos ? comma : comma - start);
+    const std::size_t first = name.find_first_not_of(" \t");
+    name = first == std::string_view::npos
+               ? std::string_view{}
+               : name.substr(first, name.find_last_not_of(" \t") - first + 1);
+    empty = empty || name.empty();
+    names.emplace_back(name);
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  bool empty = false;
-  for (const auto& n : names) empty = empty || n.empty();
-  if (names.size() != count || empty) {
-    throw std::invalid_argument("parameter '" + std::string(parameter) + "' needs " +
-                                std::to_string(count) + " comma-separated names, got '" +
-                                std::string(list) + "'");
+  if ((count != 0 && names.size() != count) || empty) {
+    const std::string how_many = count == 0 ? "one or more" : std::to_string(count);
+    throw std::invalid_argument("parameter '" + std::string(parameter) + "' needs " + how_many +
+                                " comma-separated names, got '" + std::string(list) + "'");
   }
   return names;
 }

@@ -5,8 +5,12 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "avs/runtime/parameters.hpp"
+
 namespace avs::graph::detail {
 namespace {
+
+using runtime::range_text;
 
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> row(b.size() + 1);
@@ -21,19 +25,6 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
     }
   }
   return row[b.size()];
-}
-
-std::string format_bound(double v) {
-  char buf[64];
-  auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
-  return ec == std::errc() ? std::string(buf, end) : std::to_string(v);
-}
-
-std::string range_text(std::optional<double> min, std::optional<double> max) {
-  if (min && max) return " in [" + format_bound(*min) + ", " + format_bound(*max) + "]";
-  if (min) return " >= " + format_bound(*min);
-  if (max) return " <= " + format_bound(*max);
-  return "";
 }
 
 }  // namespace

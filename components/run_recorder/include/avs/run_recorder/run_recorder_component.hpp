@@ -13,9 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "avs/msg/camera_input.hpp"
 #include "avs/msg/type_support.hpp"
 #include "avs/run_recorder/frame_assembler.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/rejections.hpp"
 
 namespace avs::run_recorder {
 
@@ -35,6 +37,7 @@ class RunRecorderComponent final : public runtime::Component {
   ~RunRecorderComponent() override;
 
   void on_deactivate() override;
+  std::vector<std::pair<std::string, std::string>> diagnostic_values() const override;
 
   [[nodiscard]] const RecorderProgress& progress() const { return progress_; }
 
@@ -58,6 +61,8 @@ class RunRecorderComponent final : public runtime::Component {
   std::vector<Eigen::Vector3d> model_points_m_;
   std::optional<std::pair<std::int64_t, Eigen::Isometry3d>> last_pose_camera_;
   bool finished_ = false;
+  runtime::SampleRejections rejected_{log(), "input"};
+  msg::CameraInput camera_{log(), rejected_};  ///< from /depth/camera_info
 };
 
 }  // namespace avs::run_recorder

@@ -23,6 +23,10 @@ enum class ClockMode : std::uint8_t {
   own_thread,  ///< a thread steps every drive at step_period_s of steady-clock time
 };
 
+/// The TCP port of the sim_amplifier component and the one servo_drive connects to unless told
+/// otherwise: Modbus's 502 needs root, a test or demo should not.
+inline constexpr int sim_amplifier_default_port = 1502;
+
 struct AmplifierServerConfig {
   std::string bind_address = "127.0.0.1";
   int port = 0;  ///< 0: the kernel picks a free port, see AmplifierServer::port()

@@ -30,6 +30,12 @@ struct AxisSafetyConfig {
   double envelope_brake_fraction = 0.5;
 };
 
+/// The safety rules of the paper's head, per axis: the motor limits of Table 3, the soft limits
+/// of our pan (+-3.0 rad) and tilt (+-1.4 rad) travel, and the envelope's inertia and gearing
+/// from the plant model (plant.hpp). servo_drive's per-axis defaults come from these.
+AxisSafetyConfig pan_safety_config();
+AxisSafetyConfig tilt_safety_config();
+
 /// When a torque command is fresh (issue 20 1.1).
 struct CommandFreshness {
   double timeout_s = 0.02;  ///< stale when its stamp or its arrival is older than this

@@ -41,8 +41,9 @@ struct JointReading {
 std::optional<JointReading> find_joint(const msgs::sensor_msgs::JointState& state,
                                        std::string_view name);
 
-/// "pan,tilt" -> {"pan", "tilt"}: exactly `count` non-empty comma-separated names; throws
-/// std::invalid_argument naming `parameter` otherwise (a configuration error).
+/// "pan, tilt" -> {"pan", "tilt"}: exactly `count` (0: one or more) non-empty comma-separated
+/// names, blanks around each trimmed; throws std::invalid_argument naming `parameter` otherwise
+/// (a configuration error).
 std::vector<std::string> parse_name_list(std::string_view list, std::size_t count,
                                          std::string_view parameter);
 
