@@ -243,10 +243,7 @@ void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntr
 }
 
 Container::Impl::Impl(const graph::Graph& g, const graph::ContainerSpec& s)
-    : graph(g),
-      spec(s),
-      log("container/" + s.name),
-      participant(dds::effective_domain(g.domain_id)) {
+    : graph(g), spec(s), log("container/" + s.name), participant(g.domain_id, g.partition) {
   scheduler = std::make_unique<Scheduler>(time_mode_for(g, s), g.clock.real_time_factor);
 }
 

@@ -4,17 +4,6 @@
 
 namespace avs::runtime::dds {
 
-int effective_domain(int configured) {
-  const char* env = std::getenv("AVS_DOMAIN_ID");
-  if (env == nullptr || *env == '\0') return configured;
-  char* end = nullptr;
-  const long id = std::strtol(env, &end, 10);
-  if (*end != '\0' || id < 0 || id > 232) {
-    throw Error(std::string("AVS_DOMAIN_ID must be a domain id in [0, 232], got '") + env + "'");
-  }
-  return static_cast<int>(id);
-}
-
 namespace {
 
 // Cyclone's default writer history cache (WhcHigh 500 KiB) holds fewer than two 512x512
@@ -38,9 +27,15 @@ dds_domainid_t prepare_domain(dds_domainid_t domain) {
 
 }  // namespace
 
-Participant::Participant(dds_domainid_t domain)
+Participant::Participant(dds_domainid_t domain, std::string partition)
     : Entity(check_dds(dds_create_participant(prepare_domain(domain), nullptr, nullptr),
-                       "create DDS participant on domain " + std::to_string(domain))) {}
+                       "create DDS participant on domain " + std::to_string(domain))),
+      domain_(domain),
+      partition_(std::move(partition)) {}
+
+void Participant::apply_partition(dds_qos_t* qos) const {
+  if (!partition_.empty()) dds_qset_partition1(qos, partition_.c_str());
+}
 
 Topic::Topic(const Participant& participant, const dds_topic_descriptor_t* descriptor,
              const std::string& name, const QosProfile& qos)
@@ -50,8 +45,9 @@ Topic::Topic(const Participant& participant, const dds_topic_descriptor_t* descr
       name_(name) {}
 
 namespace {
-Qos endpoint_qos(const QosProfile& profile) {
+Qos endpoint_qos(const Participant& participant, const QosProfile& profile) {
   Qos qos(profile);
+  participant.apply_partition(qos.get());
   // In-process delivery is done by the container without copies; DDS serves the others.
   dds_qset_ignorelocal(qos.get(), DDS_IGNORELOCAL_PARTICIPANT);
   return qos;
@@ -59,8 +55,8 @@ Qos endpoint_qos(const QosProfile& profile) {
 }  // namespace
 
 Writer::Writer(const Participant& participant, const Topic& topic, const QosProfile& qos)
-    : Entity(check_dds(dds_create_writer(participant.get(), topic.get(), endpoint_qos(qos).get(),
-                                         nullptr),
+    : Entity(check_dds(dds_create_writer(participant.get(), topic.get(),
+                                         endpoint_qos(participant, qos).get(), nullptr),
                        "create writer on " + topic.name())),
       topic_name_(topic.name()) {}
 
@@ -73,8 +69,8 @@ std::uint32_t Writer::matched_readers() const {
 }
 
 Reader::Reader(const Participant& participant, const Topic& topic, const QosProfile& qos)
-    : Entity(check_dds(dds_create_reader(participant.get(), topic.get(), endpoint_qos(qos).get(),
-                                         nullptr),
+    : Entity(check_dds(dds_create_reader(participant.get(), topic.get(),
+                                         endpoint_qos(participant, qos).get(), nullptr),
                        "create reader on " + topic.name())),
       topic_name_(topic.name()) {}
 

@@ -1,7 +1,5 @@
 #include "avs/runtime/qos.hpp"
 
-#include <cstdlib>
-
 #include "avs/runtime/error.hpp"
 
 namespace avs::runtime {
@@ -49,11 +47,6 @@ Qos::Qos(const QosProfile& profile) : qos_(dds_create_qos()) {
   // ROS 2 interop: plain CDR (XCDR1) only, see ../shared/reference/ros2-messages-and-mcap.md.
   dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
   dds_qset_data_representation(qos_.get(), 1, &xcdr1);
-  // Deployments keep systems that share a network apart by DDS partition (docs/deploy.md);
-  // `avs launch` of a deployment sets AVS_PARTITION, and tools read it too.
-  if (const char* partition = std::getenv("AVS_PARTITION"); partition != nullptr && *partition) {
-    dds_qset_partition1(qos_.get(), partition);
-  }
 }
 
 }  // namespace avs::runtime

@@ -113,7 +113,8 @@ std::vector<DiscoveredPublication> PublicationDiscovery::poll() {
 RawReader::RawReader(const Participant& participant, const msg::TypeEntry& type,
                      const std::string& dds_topic, const EndpointQos& qos)
     : topic_(dds_topic) {
-  const Qos q = qos.to_dds();
+  Qos q = qos.to_dds();
+  participant.apply_partition(q.get());
   topic_entity_ = Entity(check_dds(
       dds_create_topic(participant.get(), type.descriptor, dds_topic.c_str(), nullptr, nullptr),
       "create topic " + dds_topic + " (" + type.dds_name + ")"));
@@ -195,6 +196,7 @@ RawWriter::RawWriter(const Participant& participant, const msg::TypeEntry& type,
       "create topic " + dds_topic + " (" + type.dds_name + ")"));
   Qos q = qos.to_dds();
   dds_qset_ignorelocal(q.get(), DDS_IGNORELOCAL_PARTICIPANT);
+  participant.apply_partition(q.get());
   writer_ =
       Entity(check_dds(dds_create_writer(participant.get(), topic_entity_.get(), q.get(), nullptr),
                        "create writer on " + dds_topic));

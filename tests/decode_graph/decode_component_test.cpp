@@ -339,7 +339,6 @@ struct GraphRun {
 GraphRun run_graph(int domain, double duration_s, const std::string& decode_params,
                    const std::string& source_params = "{}",
                    const std::string& source_type = "test_plane_patterns") {
-  setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
   const auto dir = std::filesystem::temp_directory_path() /
                    ("avs_decode_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -575,7 +574,6 @@ TEST(DecodeComponent, SimulatorPlaneAtOneMetre) {
 TEST(DecodeComponent, DropsAndTimingReachDiagnosticsOverDds) {
   // /diagnostics goes out once per second of the (sim) clock, to readers in other participants:
   // a plain DDS reader here sees the component's key/values (Component::diagnostic_values).
-  setenv("AVS_DOMAIN_ID", "146", 1);
   const runtime::dds::Participant participant(146);
   using Array = msgs::diagnostic_msgs::DiagnosticArray;
   const runtime::dds::Topic topic(participant, msg::TypeSupport<Array>::descriptor(),

@@ -206,7 +206,6 @@ struct GraphRun {
 
 GraphRun run_graph(int domain, double duration_s, const std::string& matching_params,
                    const std::string& source_params = "{}") {
-  setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
   const auto dir =
       std::filesystem::temp_directory_path() /
       ("avs_matching_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
@@ -346,7 +345,6 @@ TEST(MatchingComponent, LagCompensationUsesTheDataAgeOfDepthInfo) {
 }
 
 TEST(MatchingComponent, UnknownModelFailsTheContainerLoudly) {
-  setenv("AVS_DOMAIN_ID", "152", 1);
   const auto file = std::filesystem::temp_directory_path() /
                     ("avs_matching_bad_" + std::to_string(getpid()) + ".yaml");
   {

@@ -153,7 +153,6 @@ struct GraphRun {
 /// Runs sim_amplifier + sim_scene + recorder for `duration_s` of sim time, lockstep.
 GraphRun run_graph(int domain, double duration_s, const std::string& scene_params,
                    const std::string& amplifier_params, int port = 0) {
-  setenv("AVS_DOMAIN_ID", std::to_string(domain).c_str(), 1);
   setenv("AVS_SOURCE_DIR", AVS_TEST_SOURCE_DIR, 1);
   const auto dir = std::filesystem::temp_directory_path() /
                    ("avs_sim_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));

@@ -17,6 +17,7 @@
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/error.hpp"
 #include "commands.hpp"
+#include "dds_environment.hpp"
 
 namespace avs::cli {
 
@@ -270,7 +271,8 @@ void add_bag_command(Command& app) {
       ->capture_default_str();
   record->add_option("--duration", rec.duration_s,
                      "stop after S seconds (0: until Ctrl-C/SIGTERM)");
-  rec.options.domain = runtime::dds::effective_domain(0);
+  rec.options.domain = domain_or_environment(0);
+  rec.options.partition = environment_partition();
   record->add_option("--domain", rec.options.domain,
                      "DDS domain id (default: $AVS_DOMAIN_ID or 0)");
   record->footer(
@@ -297,7 +299,8 @@ void add_bag_command(Command& app) {
   play->add_option("--delay", pl.options.delay_s,
                    "wait S seconds after creating the writers (discovery)")
       ->capture_default_str();
-  pl.options.domain = runtime::dds::effective_domain(0);
+  pl.options.domain = domain_or_environment(0);
+  pl.options.partition = environment_partition();
   play->add_option("--domain", pl.options.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)");
   play->callback([] { exit_status() = run_play(pl); });
 

@@ -25,6 +25,7 @@
 #include "avs/runtime/error.hpp"
 #include "avs/runtime/raw_topic.hpp"
 #include "avs_msgs.h"
+#include "dds_environment.hpp"
 
 extern char** environ;
 
@@ -103,7 +104,7 @@ BenchArgs parse_args(const std::vector<std::string>& raw) {
       throw runtime::Error("avs bench bag: unknown argument " + k + " (see --help)");
     }
   }
-  if (a.domain < 0) a.domain = runtime::dds::effective_domain(0);
+  if (a.domain < 0) a.domain = domain_or_environment(0);
   return a;
 }
 

@@ -16,6 +16,7 @@
 #include "avs/run_recorder/run_recorder_component.hpp"
 #include "avs/runtime/container.hpp"
 #include "commands.hpp"
+#include "dds_environment.hpp"
 #include "graph_loading.hpp"
 
 namespace avs::cli {
@@ -98,10 +99,9 @@ ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progre
   // The run is private unless asked otherwise: samples of another system on the same DDS
   // domain (a second demo, a test) would reach these components and break the lockstep
   // run's determinism. AVS_DOMAIN_ID=N shares the run with `avs topic` & co. on domain N.
-  if (const char* domain = std::getenv("AVS_DOMAIN_ID"); domain == nullptr || *domain == 0) {
-    const std::string id = std::to_string(200 + getpid() % 32);
-    setenv("AVS_DOMAIN_ID", id.c_str(), 1);
-    progress << "[" << run.scenario << "] DDS domain " << id
+  if (!environment_domain()) {
+    graph->domain_id = 200 + getpid() % 32;
+    progress << "[" << run.scenario << "] DDS domain " << graph->domain_id
              << " (private to this run; set AVS_DOMAIN_ID to watch it with avs topic)\n";
   }
   const graph::ContainerSpec& spec = graph->containers.front();

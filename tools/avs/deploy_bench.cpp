@@ -22,6 +22,7 @@
 #include "avs/runtime/error.hpp"
 #include "commands.hpp"
 #include "dds/ddsc/dds_loan_api.h"  // dds_is_shared_memory_available (not in dds.h in 0.10)
+#include "dds_environment.hpp"
 #include "sensor_msgs.h"
 
 extern char** environ;
@@ -269,7 +270,7 @@ bench::Report transport_bench(const std::vector<std::string>& args) {
     if (key == "--rate") o.rate_hz = std::stod(value);
     if (key == "--bytes") o.bytes = std::stoi(value);
   }
-  o.domain = runtime::dds::effective_domain(179);
+  o.domain = domain_or_environment(179);
   // One local host, on lo, as a deployment would configure it.
   deploy::Deployment d;
   d.hosts.push_back(deploy::Host{"local", "", "lo", {}, {}});

@@ -8,6 +8,7 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
 #include "commands.hpp"
+#include "dds_environment.hpp"
 #include "graph_loading.hpp"
 
 namespace avs::cli {
@@ -23,6 +24,7 @@ std::optional<graph::Graph> load_or_report(const std::string& file,
   graph::LoadResult result = graph::load_graph(file, args);
   for (const auto& d : result.errors) std::cerr << d.str() << "\n";
   if (!result.ok()) return std::nullopt;
+  apply_environment(*result.graph);
   return std::move(*result.graph);
 }
 

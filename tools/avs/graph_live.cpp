@@ -19,6 +19,7 @@
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/error.hpp"
 #include "commands.hpp"
+#include "dds_environment.hpp"
 #include "diagnostic_msgs.h"
 
 namespace avs::cli {
@@ -152,8 +153,9 @@ struct Options {
 };
 
 int run_graph_view(const Options& o) {
-  const int domain = o.domain >= 0 ? o.domain : runtime::dds::effective_domain(0);
-  runtime::dds::Participant participant(static_cast<dds_domainid_t>(domain));
+  const int domain = o.domain >= 0 ? o.domain : domain_or_environment(0);
+  runtime::dds::Participant participant(static_cast<dds_domainid_t>(domain),
+                                        environment_partition());
   const std::string self = [&] {
     dds_guid_t g;
     dds_get_guid(participant.get(), &g);
@@ -172,6 +174,7 @@ int run_graph_view(const Options& o) {
   runtime::dds::Topic diag_topic(participant, diag_type->descriptor, "rt/diagnostics",
                                  diag_profile);
   runtime::Qos diag_qos(diag_profile);
+  participant.apply_partition(diag_qos.get());
   runtime::dds::Entity diag_reader(runtime::check_dds(
       dds_create_reader(participant.get(), diag_topic.get(), diag_qos.get(), nullptr),
       "reader on rt/diagnostics"));
@@ -267,6 +270,7 @@ int run_graph_view(const Options& o) {
         try {
           c.topic = std::make_unique<runtime::dds::Topic>(participant, t->descriptor, e.topic, p);
           runtime::Qos q(p);
+          participant.apply_partition(q.get());
           c.reader = runtime::dds::Entity(runtime::check_dds(
               dds_create_reader(participant.get(), c.topic->get(), q.get(), nullptr), "reader"));
         } catch (const std::exception&) {

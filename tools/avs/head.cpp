@@ -14,13 +14,14 @@
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
+#include "dds_environment.hpp"
 
 namespace avs::cli {
 
 namespace {
 
 struct ResetOptions {
-  int domain = runtime::dds::effective_domain(0);
+  int domain = domain_or_environment(0);
   double wait_s = 5.0;
   std::string topic;  // empty: servo_drive's default topic
 };
@@ -42,7 +43,7 @@ int run_reset(const ResetOptions& o) {
       runtime::resolve_topic_name("/", o.topic.empty() ? port->default_topic : o.topic);
   const std::string dds_topic = runtime::to_dds_topic_name(ros_topic);
 
-  runtime::dds::Participant participant(o.domain);
+  runtime::dds::Participant participant(o.domain, environment_partition());
   runtime::dds::Topic topic(participant, type->descriptor, dds_topic, port->qos);
   runtime::dds::Writer writer(participant, topic, port->qos);
   // 1. A subscriber must be there: a volatile message sent to nobody is lost.

@@ -19,6 +19,7 @@
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
+#include "dds_environment.hpp"
 
 namespace avs::cli {
 
@@ -140,6 +141,7 @@ class RawReader {
     }
     topic_ = std::make_unique<runtime::dds::Topic>(participant, type_->descriptor, dds_name_, qos);
     runtime::Qos reader_qos(qos);
+    participant.apply_partition(reader_qos.get());
     reader_ = runtime::dds::Entity(runtime::check_dds(
         dds_create_reader(participant.get(), topic_->get(), reader_qos.get(), nullptr),
         "create reader on " + dds_name_));
@@ -181,7 +183,7 @@ class RawReader {
 
 struct CommonOptions {
   std::string topic;
-  int domain = runtime::dds::effective_domain(0);
+  int domain = domain_or_environment(0);
   double wait_s = 5.0;
   double duration_s = 0;  // 0 = until Ctrl-C
   long count = 0;         // 0 = unlimited
@@ -201,7 +203,7 @@ bool should_stop(const CommonOptions& o, Clock::time_point start) {
 }
 
 void run_list(const CommonOptions& o, bool verbose) {
-  runtime::dds::Participant participant(o.domain);
+  runtime::dds::Participant participant(o.domain, environment_partition());
   const auto topics =
       discover(participant, std::chrono::milliseconds(static_cast<int>(o.wait_s * 1000)));
   for (const auto& [name, info] : topics) {
@@ -217,7 +219,7 @@ void run_list(const CommonOptions& o, bool verbose) {
 }
 
 void run_echo(const CommonOptions& o, const introspection::YamlOptions& yaml) {
-  runtime::dds::Participant participant(o.domain);
+  runtime::dds::Participant participant(o.domain, environment_partition());
   RawReader reader(participant, o.topic, o.wait_s);
   const auto& types = introspection::built_in_types();
   const auto start = Clock::now();
@@ -237,7 +239,7 @@ void run_echo(const CommonOptions& o, const introspection::YamlOptions& yaml) {
 
 /// Rate and bandwidth over a sliding window of receive times.
 void run_rate(const CommonOptions& o, bool bandwidth, std::size_t window) {
-  runtime::dds::Participant participant(o.domain);
+  runtime::dds::Participant participant(o.domain, environment_partition());
   RawReader reader(participant, o.topic, o.wait_s);
   std::deque<std::pair<Clock::time_point, std::size_t>> samples;
   std::uint64_t total = 0;

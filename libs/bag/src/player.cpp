@@ -177,7 +177,7 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
   std::map<std::string, std::string> remaps;
   for (const auto& [from, to] : o.remaps) remaps[ros_name(from)] = ros_name(to);
 
-  dds::Participant participant(dds::effective_domain(o.domain));
+  dds::Participant participant(o.domain, o.partition);
   PlayResult result;
   std::map<std::string, std::unique_ptr<dds::RawWriter>> writers;  // by published ROS name
   std::map<mcap::ChannelId, ChannelPlan> plans;

@@ -109,7 +109,7 @@ struct Recorder::Impl {
   bool started = false;
 
   explicit Impl(RecordOptions o)
-      : options(std::move(o)), participant(dds::effective_domain(options.domain)) {}
+      : options(std::move(o)), participant(options.domain, options.partition) {}
 
   void fail(const std::string& what) {
     {

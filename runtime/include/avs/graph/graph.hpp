@@ -75,6 +75,9 @@ struct Graph {
   std::string file;
   std::string ns = "/";  ///< namespace for relative topic names
   int domain_id = 0;
+  /// DDS partition of every reader and writer; not in graph files: the command line sets it
+  /// ($AVS_PARTITION, which `avs launch` sets from a deployment's `partition`).
+  std::string partition;
   ClockSpec clock;
   std::vector<ContainerSpec> containers;
   std::map<std::string, std::string> args;  ///< final argument values (of the top-level file)

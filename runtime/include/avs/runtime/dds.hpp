@@ -13,10 +13,6 @@
 
 namespace avs::runtime::dds {
 
-/// The DDS domain to use: $AVS_DOMAIN_ID when set (tests and side-by-side systems use it
-/// to stay apart), else `configured`.
-int effective_domain(int configured);
-
 /// Owns one DDS entity handle; deletes it (and its children) on destruction.
 class Entity {
  public:
@@ -45,10 +41,22 @@ class Entity {
   dds_entity_t handle_ = 0;
 };
 
-/// Domain participant. `config_xml` may be empty (Cyclone then reads CYCLONEDDS_URI).
+/// Domain participant with the DDS partition of its readers and writers. Deployments keep
+/// systems that share a network apart by partition (docs/deploy.md); empty: the default
+/// partition. The domain and the partition come from the caller (a graph, a command-line
+/// option), never from the environment: the command line reads AVS_DOMAIN_ID/AVS_PARTITION.
 class Participant : public Entity {
  public:
-  explicit Participant(dds_domainid_t domain = 0);
+  explicit Participant(dds_domainid_t domain = 0, std::string partition = {});
+  dds_domainid_t domain() const { return domain_; }
+  const std::string& partition() const { return partition_; }
+  /// Puts the partition into the QoS of a reader or writer of this participant (every
+  /// endpoint of a user topic goes through this; built-in topic readers see all partitions).
+  void apply_partition(dds_qos_t* qos) const;
+
+ private:
+  dds_domainid_t domain_;
+  std::string partition_;
 };
 
 class Topic : public Entity {

@@ -23,6 +23,7 @@ struct PlayOptions {
   double clock_period_s = 0.01;  ///< /clock also between messages, at least this often (bag time)
   double delay_s = 0.5;  ///< wait after creating the writers (discovery) before the first sample
   int domain = 0;
+  std::string partition;  ///< DDS partition of the readers/writers; empty: default
 };
 
 struct PlayProgress {

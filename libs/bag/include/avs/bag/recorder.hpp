@@ -38,6 +38,7 @@ struct RecordOptions {
   /// Close the open chunk at least this often, so a killed recorder loses at most this much.
   double flush_interval_s = 1.0;
   int domain = 0;
+  std::string partition;  ///< DDS partition of the readers/writers; empty: default
 };
 
 /// Counters of one topic (cumulative).
