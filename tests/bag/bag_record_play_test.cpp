@@ -39,7 +39,7 @@ fs::path temp_dir() {
 }
 
 std::string talker_graph() {
-  return source_dir() + "/launch_config/talker_listener.yaml";
+  return source_dir() + "/tests/support/graphs/talker_listener.yaml";
 }
 
 int exit_code(int status) {

@@ -17,9 +17,9 @@ AVS=${1:?avs binary}
 SRC=${2:?source dir}
 MODE=${3:-multicast}
 if [[ $MODE == unicast ]]; then
-  DEPLOY=${4:-$SRC/launch_config/deploy/three_hosts_unicast.yaml}
+  DEPLOY=${4:-$SRC/tests/support/graphs/deploy/three_hosts_unicast.yaml}
 else
-  DEPLOY=${4:-$SRC/launch_config/deploy/three_hosts.yaml}
+  DEPLOY=${4:-$SRC/tests/support/graphs/deploy/three_hosts.yaml}
 fi
 # host:topic read there, published on A.
 DELIVERY=${DELIVERY:-"B:/chatter C:/head/torque_command"}

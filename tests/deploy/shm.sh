@@ -13,7 +13,7 @@ W=$(mktemp -d /tmp/avs_shm.XXXXXX)
 trap 'rm -rf "$W"' EXIT
 fail() { echo "FAIL: $*"; tail -n 20 "$W/launch.log"; exit 1; }
 
-"$AVS" launch "$SRC/launch_config/deploy/one_host_shm.yaml" duration_s:=3 report_dir:="$W" >"$W/launch.log" 2>&1 ||
+"$AVS" launch "$SRC/tests/support/graphs/deploy/one_host_shm.yaml" duration_s:=3 report_dir:="$W" >"$W/launch.log" 2>&1 ||
   fail "avs launch with shared memory failed"
 grep -q "shared memory through .*iox-roudi" "$W/launch.log" || fail "avs launch did not start RouDi"
 received=$(awk '/^received:/ {print $2}' "$W/remote_listener.yaml" 2>/dev/null)

@@ -5,7 +5,7 @@ set -euo pipefail
 avs=$1; src=$2
 . "$src/tests/integration/lib.sh"
 out=$(mktemp -d)
-"$avs" launch "$src/launch_config/talker_listener.yaml" rate_hz:=100 report_dir:="$out" 2> "$out/log" &
+"$avs" launch "$src/tests/support/graphs/talker_listener.yaml" rate_hz:=100 report_dir:="$out" 2> "$out/log" &
 launcher=$!
 trap 'kill $launcher 2>/dev/null || true; rm -rf "$out"' EXIT
 

@@ -6,7 +6,7 @@ avs=$1; src=$2
 . "$src/tests/integration/lib.sh"
 out=$(mktemp -d); trap 'rm -rf "$out"' EXIT
 
-"$avs" launch "$src/launch_config/talker_listener.yaml" duration_s:=3 rate_hz:=200 report_dir:="$out" 2> "$out/log" \
+"$avs" launch "$src/tests/support/graphs/talker_listener.yaml" duration_s:=3 rate_hz:=200 report_dir:="$out" 2> "$out/log" \
   || { cat "$out/log"; fail "avs launch exited with $?"; }
 cat "$out/log"
 local_rx=$(value "$out/local_listener.yaml" received)

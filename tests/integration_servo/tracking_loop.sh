@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Closed visual-servo loop in lockstep (launch_config/servo_tracking_loop.yaml): a sphere
+# Closed visual-servo loop in lockstep (tests/support/graphs/servo_tracking_loop.yaml): a sphere
 # swinging laterally at up to 1 m/s at 1 m, depth images through the true head angles,
 # tracking -> servo_drive -> Modbus -> simulated head. With tracking the target stays in view
 # for the whole run and the centroid error RMS is at most 20 px; without tracking (the head
@@ -9,7 +9,7 @@ avs=$1; src=$2
 . "$src/tests/integration_servo/lib.sh"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-loop="$src/launch_config/servo_tracking_loop.yaml"
+loop="$src/tests/support/graphs/servo_tracking_loop.yaml"
 run_loop() {  # dir, args...
   local dir=$1; shift
   mkdir -p "$dir"

@@ -18,7 +18,8 @@ class TestListener final : public runtime::Component {
   static ComponentSpec spec() {
     return {.type = "test_listener",
             .description = "counts test_talker samples and same-buffer deliveries",
-            .parameters = {ParamSpec::string("report_dir", "", "folder for <name>.yaml written on stop, empty = none")},
+            .parameters = {ParamSpec::string(
+                "report_dir", "", "folder for <name>.yaml written on stop, empty = none")},
             .publishes = {},
             .subscribes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter")}};
   }

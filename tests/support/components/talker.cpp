@@ -14,17 +14,18 @@ using runtime::ParamSpec;
 class TestTalker final : public runtime::Component {
  public:
   static ComponentSpec spec() {
-    return {.type = "test_talker",
-            .description = "publishes '<seq> <sample address>' strings at rate_hz",
-            .parameters = {ParamSpec::real("rate_hz", 100.0, 0.001, 100000.0, "Hz", "publishing rate"),
-                           ParamSpec::integer("count", 0, 0, std::nullopt, "",
-                                              "messages to send, 0 = until stopped"),
-                           ParamSpec::integer("fail_after", 0, 0, std::nullopt, "",
-                                              "throw after this many messages (tests failure "
-                                              "reporting and respawn), 0 = never")},
-            .publishes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter"),
-                          runtime::port<msgs::std_msgs::Float64>("count", "talker_count")},
-            .subscribes = {}};
+    return {
+        .type = "test_talker",
+        .description = "publishes '<seq> <sample address>' strings at rate_hz",
+        .parameters = {ParamSpec::real("rate_hz", 100.0, 0.001, 100000.0, "Hz", "publishing rate"),
+                       ParamSpec::integer("count", 0, 0, std::nullopt, "",
+                                          "messages to send, 0 = until stopped"),
+                       ParamSpec::integer("fail_after", 0, 0, std::nullopt, "",
+                                          "throw after this many messages (tests failure "
+                                          "reporting and respawn), 0 = never")},
+        .publishes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter"),
+                      runtime::port<msgs::std_msgs::Float64>("count", "talker_count")},
+        .subscribes = {}};
   }
 
   explicit TestTalker(ComponentContext& ctx)
