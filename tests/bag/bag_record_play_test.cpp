@@ -1,6 +1,6 @@
 // `avs bag` end to end: record a running graph (other processes) and read the values back,
 // play into a subscriber and compare byte for byte, SIGKILL then repair, SIGTERM closes
-// cleanly, and loss is counted and reported, never silent. DDS domains 160-164.
+// cleanly, and loss is counted and reported, never silent. DDS domains leased (tests/support).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -91,14 +91,14 @@ void expect_consecutive(const std::vector<std::uint64_t>& seqs, const char* what
 
 /// Records /chatter and /talker_count of the talker graph for `seconds` (own domain); returns
 /// the recorder's output.
-std::string record_talker(int domain, const fs::path& file, const char* seconds) {
-  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"}, domain,
-                   temp_dir() / ("graph" + std::to_string(domain) + ".log"));
+std::string record_talker(const fs::path& file, const char* seconds) {
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"},
+                   temp_dir() / ("graph" + std::to_string(avs::testing::test_domain()) + ".log"));
   EXPECT_TRUE(graph.started());
   std::this_thread::sleep_for(1500ms);
   AvsProcess rec(
       {"bag", "record", "/chatter", "talker_count", "-o", file.string(), "--duration", seconds},
-      domain, temp_dir() / ("record" + std::to_string(domain) + ".log"));
+      temp_dir() / ("record" + std::to_string(avs::testing::test_domain()) + ".log"));
   const int status = rec.wait(30s);
   const std::string out = rec.output();
   EXPECT_EQ(exit_code(status), 0) << out;
@@ -136,9 +136,8 @@ TEST(BagQos, OfferedQosYamlRoundTripsAndReadsRosbag2Text) {
 }
 
 TEST(BagRecord, RecordsARunningGraphAndReadsTheValuesBack) {
-  constexpr int kDomain = 160;
   const fs::path file = temp_dir() / "talker.mcap";
-  const std::string out = record_talker(kDomain, file, "2.5");
+  const std::string out = record_talker(file, "2.5");
   ASSERT_FALSE(HasFailure());
   EXPECT_NE(out.find("/chatter"), std::string::npos) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex("total: [0-9]+ received, [0-9]+ written, 0 lost")))
@@ -189,7 +188,7 @@ TEST(BagRecord, RecordsARunningGraphAndReadsTheValuesBack) {
     EXPECT_LE(m.log_time - std::min(m.log_time, m.publish_time), 1'000'000'000u);
   }
 
-  AvsProcess info({"bag", "info", file.string()}, kDomain, temp_dir() / "info160.log");
+  AvsProcess info({"bag", "info", file.string()}, temp_dir() / "info160.log");
   ASSERT_EQ(exit_code(info.wait(10s)), 0);
   const std::string text = info.output();
   EXPECT_NE(text.find("std_msgs/msg/String"), std::string::npos) << text;
@@ -198,9 +197,8 @@ TEST(BagRecord, RecordsARunningGraphAndReadsTheValuesBack) {
 }
 
 TEST(BagPlay, RepublishesTheRecordedBytesWithTheirTiming) {
-  constexpr int kDomain = 161;
   const fs::path file = temp_dir() / "to_play.mcap";
-  record_talker(kDomain, file, "1.5");
+  record_talker(file, "1.5");
   ASSERT_FALSE(HasFailure());
   const auto recorded = read_all(file);
   std::vector<const Recorded*> chatter;
@@ -209,14 +207,14 @@ TEST(BagPlay, RepublishesTheRecordedBytesWithTheirTiming) {
   }
   ASSERT_FALSE(chatter.empty());
 
-  runtime::dds::Participant participant(kDomain);
+  runtime::dds::Participant participant(avs::testing::test_domain());
   runtime::dds::EndpointQos qos;
   qos.keep_all = true;
   runtime::dds::RawReader reader(participant, *msg::find_type("std_msgs::msg::dds_::String_"),
                                  "rt/replayed", qos);
   AvsProcess play({"bag", "play", file.string(), "--topics", "/chatter", "--remap",
                    "/chatter:=/replayed", "--delay", "1.5"},
-                  kDomain, temp_dir() / "play161.log");
+                  temp_dir() / "play161.log");
   std::vector<std::vector<std::uint8_t>> got;
   std::vector<std::chrono::steady_clock::time_point> when;
   int status = -1;
@@ -252,14 +250,12 @@ TEST(BagPlay, RepublishesTheRecordedBytesWithTheirTiming) {
 }
 
 TEST(BagRecord, SigkillLeavesAFileReadableToItsLastChunkAndRepairRestoresTheSummary) {
-  constexpr int kDomain = 162;
   const fs::path file = temp_dir() / "killed.mcap";
-  AvsProcess graph({"launch", talker_graph(), "rate_hz:=500"}, kDomain,
-                   temp_dir() / "graph162.log");
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=500"}, temp_dir() / "graph162.log");
   std::this_thread::sleep_for(1500ms);
   AvsProcess rec({"bag", "record", "/chatter", "-o", file.string(), "--compression", "lz4",
                   "--flush-interval", "0.2"},
-                 kDomain, temp_dir() / "record162.log");
+                 temp_dir() / "record162.log");
   std::this_thread::sleep_for(3s);
   rec.signal(SIGKILL);
   ASSERT_GE(rec.wait(10s), 0);
@@ -275,7 +271,7 @@ TEST(BagRecord, SigkillLeavesAFileReadableToItsLastChunkAndRepairRestoresTheSumm
   ASSERT_GT(seqs.size(), 100u) << "at 500 Hz, chunks closed every 0.2 s";
   expect_consecutive(seqs, "/chatter before repair");
 
-  AvsProcess repair({"bag", "repair", file.string()}, kDomain, temp_dir() / "repair162.log");
+  AvsProcess repair({"bag", "repair", file.string()}, temp_dir() / "repair162.log");
   ASSERT_EQ(exit_code(repair.wait(30s)), 0) << repair.output();
   mcap::Reader reader;
   ASSERT_TRUE(reader.open(file).ok());
@@ -287,12 +283,10 @@ TEST(BagRecord, SigkillLeavesAFileReadableToItsLastChunkAndRepairRestoresTheSumm
 }
 
 TEST(BagRecord, SigtermClosesTheFileCleanly) {
-  constexpr int kDomain = 163;
   const fs::path file = temp_dir() / "terminated.mcap";
-  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"}, kDomain,
-                   temp_dir() / "graph163.log");
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"}, temp_dir() / "graph163.log");
   std::this_thread::sleep_for(1500ms);
-  AvsProcess rec({"bag", "record", "-a", "-x", "diagnostics", "-o", file.string()}, kDomain,
+  AvsProcess rec({"bag", "record", "-a", "-x", "diagnostics", "-o", file.string()},
                  temp_dir() / "record163.log");
   std::this_thread::sleep_for(2s);
   rec.signal(SIGTERM);
@@ -311,13 +305,12 @@ TEST(BagRecord, SigtermClosesTheFileCleanly) {
 }
 
 TEST(BagRecord, LossIsCountedAndReportedNeverSilent) {
-  constexpr int kDomain = 164;
   constexpr std::uint64_t kSent = 3000;
   const fs::path file = temp_dir() / "lossy.mcap";
   // A recorder whose own queue holds a single sample: a burst overflows it.
-  AvsProcess rec({"bag", "record", "/burst", "-o", file.string(), "--queue-size", "0"}, kDomain,
+  AvsProcess rec({"bag", "record", "/burst", "-o", file.string(), "--queue-size", "0"},
                  temp_dir() / "record164.log");
-  runtime::dds::Participant participant(kDomain);
+  runtime::dds::Participant participant(avs::testing::test_domain());
   runtime::QosProfile q;
   q.depth = static_cast<std::uint32_t>(kSent);
   runtime::dds::Topic topic(participant, &std_msgs_msg_dds__String__desc, "rt/burst", q);
@@ -388,30 +381,28 @@ std::map<std::int64_t, Pose> poses_by_stamp(const fs::path& file) {
 // Issue 7 point 5: record the pattern frames (and poses) of a simulated run, replay the
 // frames with --clock into decode + matching following /clock, get the same poses.
 TEST(BagReplay, ReplayedPatternFramesGiveTheLiveRunsPoses) {
-  constexpr int kDomain = 169;
   const std::string data = source_dir() + "/tests/bag/data/";
   const fs::path live = temp_dir() / "live.mcap";
   const fs::path replay = temp_dir() / "replay.mcap";
   {
     AvsProcess rec({"bag", "record", "/camera/pattern", "/object/pose", "-o", live.string()},
-                   kDomain, temp_dir() / "record169_live.log");
+                   temp_dir() / "record169_live.log");
     std::this_thread::sleep_for(1s);
-    AvsProcess graph({"launch", data + "replay_live.yaml"}, kDomain,
-                     temp_dir() / "graph169_live.log");
+    AvsProcess graph({"launch", data + "replay_live.yaml"}, temp_dir() / "graph169_live.log");
     ASSERT_EQ(exit_code(graph.wait(120s)), 0) << graph.output();
     std::this_thread::sleep_for(1s);
     rec.signal(SIGINT);
     ASSERT_EQ(exit_code(rec.wait(30s)), 0) << rec.output();
   }
   {
-    AvsProcess graph({"container", data + "replay_reprocess.yaml", "--name", "reprocess"}, kDomain,
+    AvsProcess graph({"container", data + "replay_reprocess.yaml", "--name", "reprocess"},
                      temp_dir() / "graph169_replay.log");
-    AvsProcess rec({"bag", "record", "/object/pose", "-o", replay.string()}, kDomain,
+    AvsProcess rec({"bag", "record", "/object/pose", "-o", replay.string()},
                    temp_dir() / "record169_replay.log");
     std::this_thread::sleep_for(2s);
     AvsProcess play({"bag", "play", live.string(), "--topics", "/camera/pattern", "--clock",
                      "--rate", "1", "--delay", "1"},
-                    kDomain, temp_dir() / "play169.log");
+                    temp_dir() / "play169.log");
     ASSERT_EQ(exit_code(play.wait(120s)), 0) << play.output();
     std::this_thread::sleep_for(2s);
     rec.signal(SIGINT);

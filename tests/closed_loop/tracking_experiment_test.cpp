@@ -37,9 +37,9 @@ TEST(ClosedLoop, TrackingKeepsTheSwingingTargetInViewAndHoldingStillLosesIt) {
       fs::temp_directory_path() / ("avs-tracking-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string json_file = dir.string() + ".json";
-  const int status =
-      avs::testing::run_avs("experiments tracking no_tracking --json --out " + dir.string(), 191,
-                            json_file, dir.string() + ".log");
+  const int status = avs::testing::run_avs(
+      {"experiments", "tracking", "no_tracking", "--json", "--out", dir.string()}, json_file,
+      dir.string() + ".log");
   const std::string json = read_file(json_file);
   ASSERT_EQ(status, 0) << json << read_file(dir.string() + ".log");
 

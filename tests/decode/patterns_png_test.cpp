@@ -15,6 +15,7 @@
 
 #include "avs/decode/gray_code.hpp"
 #include "avs/decode/png_io.hpp"
+#include "avs/testing/child_process.hpp"
 
 namespace avs::decode {
 namespace {
@@ -56,13 +57,13 @@ class PatternsCommand : public ::testing::Test {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  int run(const std::string& args) {
-    const std::string command = std::string(AVS_EXE) + " patterns --out " + dir_.string() + " " +
-                                args + " > " + (dir_.string() + ".log") + " 2>&1";
-    const int status = std::system(command.c_str());
-    std::ifstream log(dir_.string() + ".log");
-    log_.assign(std::istreambuf_iterator<char>(log), {});
-    std::filesystem::remove(dir_.string() + ".log");
+  int run(std::vector<std::string> options) {
+    std::vector<std::string> argv = {AVS_EXE, "patterns", "--out", dir_.string()};
+    argv.insert(argv.end(), options.begin(), options.end());
+    const std::string log = dir_.string() + ".log";
+    const int status = avs::testing::run_program(std::move(argv), {}, log);
+    log_ = avs::testing::read_file(log);
+    std::filesystem::remove(log);
     return status;
   }
 
@@ -71,7 +72,7 @@ class PatternsCommand : public ::testing::Test {
 };
 
 TEST_F(PatternsCommand, WritesEq1PatternsInProjectionOrder) {
-  ASSERT_EQ(run(""), 0) << log_;
+  ASSERT_EQ(run({}), 0) << log_;
   const CodeLayout layout{9, 265, 4, 40};  // paper: 265 codes over 1060 of 1140 rows, centred
   const std::vector<IndexRow> index = read_index(dir_ / "index.csv");
   ASSERT_EQ(index.size(), 18u);
@@ -138,7 +139,9 @@ TEST_F(PatternsCommand, WritesEq1PatternsInProjectionOrder) {
 }
 
 TEST_F(PatternsCommand, OptionsChangeLayoutAndBadOnesAreRefused) {
-  ASSERT_EQ(run("--bits 4 --codes 16 --rows 64 --width 32 --height 80"), 0) << log_;
+  ASSERT_EQ(
+      run({"--bits", "4", "--codes", "16", "--rows", "64", "--width", "32", "--height", "80"}), 0)
+      << log_;
   const auto index = read_index(dir_ / "index.csv");
   ASSERT_EQ(index.size(), 8u);
   const GrayImage8 msb = read_png_gray8((dir_ / index[0].file).string());
@@ -152,9 +155,9 @@ TEST_F(PatternsCommand, OptionsChangeLayoutAndBadOnesAreRefused) {
   EXPECT_EQ(msb.pixels[71 * 32], 255);
   EXPECT_EQ(msb.pixels[72 * 32], 0);
 
-  EXPECT_NE(run("--rows 1000"), 0);  // not a multiple of 265
+  EXPECT_NE(run({"--rows", "1000"}), 0);  // not a multiple of 265
   EXPECT_NE(log_.find("multiple"), std::string::npos) << log_;
-  EXPECT_NE(run("--bits 8"), 0);  // 265 codes do not fit 8 bits
+  EXPECT_NE(run({"--bits", "8"}), 0);  // 265 codes do not fit 8 bits
   EXPECT_NE(log_.find("do not fit"), std::string::npos) << log_;
 }
 

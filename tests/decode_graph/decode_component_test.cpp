@@ -26,6 +26,8 @@
 #include "avs/runtime/container.hpp"
 #include "avs/runtime/dds.hpp"
 #include "avs/sim/simulator.hpp"
+#include "avs/testing/lockstep_graph.hpp"
+#include "avs/testing/test_domain.hpp"
 
 namespace avs::decode {
 namespace {
@@ -336,38 +338,24 @@ struct GraphRun {
   std::int64_t count(const std::string& key) const { return std::stoll(diagnostic(key)); }
 };
 
-GraphRun run_graph(int domain, double duration_s, const std::string& decode_params,
+GraphRun run_graph(double duration_s, const std::string& decode_params,
                    const std::string& source_params = "{}",
                    const std::string& source_type = "test_plane_patterns") {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("avs_decode_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string file = (dir / "graph.yaml").string();
-  {
-    std::ofstream out(file);
-    out << "domain_id: " << domain << "\n"
-        << "clock: {source: sim, mode: lockstep, duration_s: " << duration_s << "}\n"
-        << "containers:\n"
-        << "  - name: depth\n"
-        << "    executor: single_threaded\n"
-        << "    components:\n"
-        << "      - {type: " << source_type << ", name: source, parameters: " << source_params
-        << "}\n"
-        << "      - {type: decode, name: decode, parameters: " << decode_params << "}\n"
-        << "      - {type: test_depth_recorder, name: recorder}\n";
-  }
-  graph::LoadResult loaded = graph::load_graph(file, {});
-  std::filesystem::remove_all(dir);
-  for (const auto& e : loaded.errors) ADD_FAILURE() << e.str();
+  avs::testing::ContainerRun ran = avs::testing::run_lockstep_container(
+      {"{type: " + source_type + ", name: source, parameters: " + source_params + "}",
+       "{type: decode, name: decode, parameters: " + decode_params + "}",
+       "{type: test_depth_recorder, name: recorder}"},
+      duration_s);
+  for (const auto& e : ran.load_errors) ADD_FAILURE() << e;
   GraphRun run;
-  if (!loaded.ok()) return run;
-  run.graph = std::make_unique<graph::Graph>(std::move(*loaded.graph));
-  run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
-  EXPECT_EQ(run.container->run(), 0);
-  run.source = dynamic_cast<TestPlanePatterns*>(run.container->find_component("source"));
-  run.sim_source = dynamic_cast<TestSimPlanePatterns*>(run.container->find_component("source"));
-  run.recorder = dynamic_cast<TestDepthRecorder*>(run.container->find_component("recorder"));
-  run.decode = run.container->find_component("decode");
+  if (!ran.container) return run;
+  EXPECT_EQ(ran.status, 0);
+  run.source = ran.find<TestPlanePatterns>("source");
+  run.sim_source = ran.find<TestSimPlanePatterns>("source");
+  run.recorder = ran.find<TestDepthRecorder>("recorder");
+  run.decode = ran.find<runtime::Component>("decode");
+  run.graph = std::move(ran.graph);
+  run.container = std::move(ran.container);
   EXPECT_TRUE(run.source != nullptr || run.sim_source != nullptr);
   EXPECT_NE(run.recorder, nullptr);
   EXPECT_NE(run.decode, nullptr);
@@ -388,7 +376,7 @@ void expect_accurate(const DepthRecord& r, const std::string& what) {
 }
 
 TEST(DecodeComponent, RollingDepthPerPairMatchesThePlane) {
-  const GraphRun run = run_graph(140, 0.1, "{publish_points: true}");
+  const GraphRun run = run_graph(0.1, "{publish_points: true}");
   ASSERT_NE(run.recorder, nullptr);
   const auto& stamps = run.source->stamps_ns;
   const auto& depth = run.recorder->depth;
@@ -462,7 +450,7 @@ TEST(DecodeComponent, DroppedFrameIsCountedAndInvalidatesOnlyItsBitsWindow) {
   // Frame 2 * 18 + 6 = the positive of bit 3 in cycle 2 is lost: pair (42, 43) cannot be
   // decoded; bit 3 is missing from the window until it is measured again in cycle 3.
   const std::int64_t lost = 2 * kFramesPerCycle + 2 * 3;
-  const GraphRun run = run_graph(141, 0.1, "{}", "{drop_frames: [" + std::to_string(lost) + "]}");
+  const GraphRun run = run_graph(0.1, "{}", "{drop_frames: [" + std::to_string(lost) + "]}");
   ASSERT_NE(run.recorder, nullptr);
   EXPECT_EQ(run.count("dropped_frames"), 1);
   EXPECT_EQ(run.count("incomplete_pairs"), 1);
@@ -492,8 +480,8 @@ TEST(DecodeComponent, OutOfOrderFrameIsDiscardedNotMisplaced) {
   // The positive of bit 5 in cycle 2 arrives after its negative: the negative has no positive
   // (incomplete), the late positive is older than the newest frame (out of order, discarded).
   const std::int64_t late = 2 * kFramesPerCycle + 2 * 5;
-  const GraphRun run = run_graph(142, 0.1, "{max_bit_age_pairs: 18}",
-                                 "{swap_frames: [" + std::to_string(late) + "]}");
+  const GraphRun run =
+      run_graph(0.1, "{max_bit_age_pairs: 18}", "{swap_frames: [" + std::to_string(late) + "]}");
   ASSERT_NE(run.recorder, nullptr);
   EXPECT_EQ(run.count("out_of_order_frames"), 1);
   EXPECT_EQ(run.count("incomplete_pairs"), 1);
@@ -516,7 +504,7 @@ TEST(DecodeComponent, OutOfOrderFrameIsDiscardedNotMisplaced) {
 }
 
 TEST(DecodeComponent, FullCycleModePublishesOncePerCycleLikeDecodeFullCycle) {
-  const GraphRun run = run_graph(143, 0.08, "{mode: full_cycle}");
+  const GraphRun run = run_graph(0.08, "{mode: full_cycle}");
   ASSERT_NE(run.recorder, nullptr);
   const auto& stamps = run.source->stamps_ns;
   const auto& depth = run.recorder->depth;
@@ -546,7 +534,7 @@ TEST(DecodeComponent, FullCycleModePublishesOncePerCycleLikeDecodeFullCycle) {
 TEST(DecodeComponent, SimulatorPlaneAtOneMetre) {
   // Frames from the simulator's renderer (its own pattern order, projector model, shading and
   // noise) against its ground truth.
-  const GraphRun run = run_graph(145, 0.06, "{}", "{}", "test_sim_plane_patterns");
+  const GraphRun run = run_graph(0.06, "{}", "{}", "test_sim_plane_patterns");
   ASSERT_NE(run.sim_source, nullptr);
   const Truth& truth = run.sim_source->truth();
   double centre_depth = truth.depth_m[256 * 512 + 256];
@@ -574,12 +562,12 @@ TEST(DecodeComponent, SimulatorPlaneAtOneMetre) {
 TEST(DecodeComponent, DropsAndTimingReachDiagnosticsOverDds) {
   // /diagnostics goes out once per second of the (sim) clock, to readers in other participants:
   // a plain DDS reader here sees the component's key/values (Component::diagnostic_values).
-  const runtime::dds::Participant participant(146);
+  const runtime::dds::Participant participant(avs::testing::test_domain());
   using Array = msgs::diagnostic_msgs::DiagnosticArray;
   const runtime::dds::Topic topic(participant, msg::TypeSupport<Array>::descriptor(),
                                   "rt/diagnostics", runtime::QosProfile{});
   const runtime::dds::Reader reader(participant, topic, runtime::QosProfile{});
-  const GraphRun run = run_graph(146, 1.05, "{}", "{drop_frames: [100, 501]}");
+  const GraphRun run = run_graph(1.05, "{}", "{drop_frames: [100, 501]}");
   ASSERT_NE(run.recorder, nullptr);
   std::map<std::string, std::string> values;
   for (;;) {
@@ -589,13 +577,13 @@ TEST(DecodeComponent, DropsAndTimingReachDiagnosticsOverDds) {
     if (dds_take(reader.get(), buffers, &info, 1, 1) <= 0) break;
     if (!info.valid_data) continue;
     for (const auto& status : runtime::as_span(sample->status)) {
-      if (runtime::get_string(status.name) != "depth/decode") continue;
+      if (runtime::get_string(status.name) != "test/decode") continue;
       for (const auto& kv : runtime::as_span(status.values)) {
         values[std::string(runtime::get_string(kv.key))] = runtime::get_string(kv.value);
       }
     }
   }
-  ASSERT_FALSE(values.empty()) << "no /diagnostics status of depth/decode received";
+  ASSERT_FALSE(values.empty()) << "no /diagnostics status of test/decode received";
   EXPECT_EQ(values["dropped_frames"], "2");  // both drops happened before t = 1 s
   // Frame 100 is the positive of bit 5: its negative is an incomplete pair; frame 501 is the
   // negative of bit 7: its positive is simply replaced by the next one.
@@ -614,9 +602,9 @@ TEST(DecodeComponent, WrongFrameSizeIsRejectedAndCountedWithoutStoppingTheContai
     std::ofstream out(file);
     out << "camera: {width: 256, height: 256, fx: 314.4, fy: 314.4, cx: 127.5, cy: 127.5}\n";
   }
-  testing::internal::CaptureStderr();
-  const GraphRun run = run_graph(144, 0.02, "{calibration_file: " + file.string() + "}");
-  const std::string err = testing::internal::GetCapturedStderr();
+  ::testing::internal::CaptureStderr();
+  const GraphRun run = run_graph(0.02, "{calibration_file: " + file.string() + "}");
+  const std::string err = ::testing::internal::GetCapturedStderr();
   std::filesystem::remove(file);
   ASSERT_NE(run.recorder, nullptr);
   EXPECT_NE(err.find("size 512x512, the calibration's camera is 256x256"), std::string::npos)
@@ -680,14 +668,14 @@ int publish_malformed_frames(int domain, int count) {
 TEST(DecodeComponent, MalformedFramesFromAnotherProcessAreRejectedAndDepthGoesOn) {
   // Issue 13 section 3: a second process publishes malformed frames into a running decode
   // graph; the container keeps producing depth from the good frames and the counter rises.
-  constexpr int kDomain = 147;
+  const int kDomain = avs::testing::test_domain();
   constexpr int kBad = 30;
   const pid_t child = fork();
   ASSERT_GE(child, 0);
   if (child == 0) _exit(publish_malformed_frames(kDomain, kBad));
   // Long enough in sim time (lockstep: several seconds of wall time) for the child to be
   // discovered and send everything while the graph runs.
-  const GraphRun run = run_graph(kDomain, 4.0, "{}");
+  const GraphRun run = run_graph(4.0, "{}");
   int child_status = 0;
   ASSERT_EQ(waitpid(child, &child_status, 0), child);
   ASSERT_TRUE(WIFEXITED(child_status));

@@ -1,35 +1,25 @@
 // Helpers for tests that run the `avs` program (AVS_PROGRAM) and read what it wrote.
 #pragma once
 
-#include <sys/wait.h>
-
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <regex>
-#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include "avs/testing/child_process.hpp"
+#include "avs/testing/test_domain.hpp"
 
 namespace avs::testing {
 
-inline std::string read_file(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-/// Runs `AVS_DOMAIN_ID=domain avs ARGS > out 2> err`; returns the exit status (-1 if the
-/// program did not exit normally).
-inline int run_avs(const std::string& args, int domain, const std::filesystem::path& out,
+/// Runs `avs WORDS...` (AVS_PROGRAM) on this test's DDS domain, stdout to `out`, stderr to
+/// `err`; the exit code, or -1 if the program did not exit normally.
+inline int run_avs(std::vector<std::string> words, const std::filesystem::path& out,
                    const std::filesystem::path& err) {
-  const std::string command = "AVS_DOMAIN_ID=" + std::to_string(domain) + " " +
-                              std::string(AVS_PROGRAM) + " " + args + " > " + out.string() +
-                              " 2> " + err.string();
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  words.insert(words.begin(), AVS_PROGRAM);
+  return run_program(std::move(words), {"AVS_DOMAIN_ID=" + std::to_string(test_domain())}, out,
+                     err);
 }
 
 /// The number after `"key": ` in `json` (null -> NaN); throws when the key is missing.

@@ -2,7 +2,7 @@
 // valid PNGs with data drawn in them, and the results table's numbers are the ones computed
 // from the rows this run recorded (nothing hard-coded): summary.json is recomputed here from
 // frames.csv, and the run's rates follow from its own simulated duration.
-// Its own DDS domain (190): a concurrent test on the default domain must not feed this run.
+// Its own DDS domain (leased, tests/support): a concurrent test must not feed this run.
 #include <png.h>
 #include <sys/wait.h>
 
@@ -49,9 +49,8 @@ TEST(Demo, ShortRunMakesAReportFromItsOwnData) {
   fs::remove_all(dir);
   const double seconds = 0.6;
   const std::string log = (dir.string() + ".log");
-  const int status =
-      avs::testing::run_avs("demo --seconds " + std::to_string(seconds) + " --out " + dir.string(),
-                            190, log, log + ".err");
+  const int status = avs::testing::run_avs(
+      {"demo", "--seconds", std::to_string(seconds), "--out", dir.string()}, log, log + ".err");
   const std::string output = read_file(log) + read_file(log + ".err");
   ASSERT_EQ(status, 0) << output;
 

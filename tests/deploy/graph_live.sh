@@ -5,6 +5,7 @@
 set -u
 AVS=${1:?avs binary}
 SRC=${2:?source dir}
+. "$(dirname "${BASH_SOURCE[0]}")/../support/test_domain.sh"  # AVS_DOMAIN_ID of its own
 OUT=$(mktemp /tmp/avs_graph_live.XXXXXX)
 PIDS=()
 cleanup() { kill -TERM "${PIDS[@]}" 2>/dev/null; wait 2>/dev/null; rm -f "$OUT"; }

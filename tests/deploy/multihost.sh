@@ -15,6 +15,7 @@
 set -u
 AVS=${1:?avs binary}
 SRC=${2:?source dir}
+. "$(dirname "${BASH_SOURCE[0]}")/../support/test_domain.sh"  # AVS_DOMAIN_ID of its own
 MODE=${3:-multicast}
 if [[ $MODE == unicast ]]; then
   DEPLOY=${4:-$SRC/tests/support/graphs/deploy/three_hosts_unicast.yaml}

@@ -13,6 +13,7 @@
 set -u
 AVS=${1:?avs binary}
 SRC=${2:?source dir}
+. "$(dirname "${BASH_SOURCE[0]}")/../support/test_domain.sh"  # AVS_DOMAIN_ID of its own
 DOMAIN=${AVS_DOMAIN_ID:-173}
 MARKER=avsPlainMarker7
 W=$(mktemp -d /tmp/avs_security.XXXXXX)

@@ -2,8 +2,9 @@
 # of our own (from the test's DDS domain), and the graph runner.
 fail() { echo "FAIL: $*" >&2; exit 1; }
 value() { grep "^$2:" "$1" | awk '{print $2}'; }
-# Tests run in parallel: each gets its own Modbus port, derived from its AVS_DOMAIN_ID.
-port=$((15000 + ${AVS_DOMAIN_ID:-120}))
+# Tests run in parallel: each leases a DDS domain (AVS_DOMAIN_ID) and a Modbus port of its own.
+. "$(dirname "${BASH_SOURCE[0]}")/../support/test_domain.sh"
+port=$AVS_TEST_PORT
 graph="$src/tests/integration_servo/data/head.yaml"
 # run_head DIR [name:=value ...]: runs the head graph with reports in DIR.
 run_head() {

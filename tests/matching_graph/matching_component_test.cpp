@@ -26,6 +26,8 @@
 #include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
+#include "avs/testing/lockstep_graph.hpp"
+#include "avs/testing/test_domain.hpp"
 
 namespace avs::matching {
 namespace {
@@ -204,36 +206,21 @@ struct GraphRun {
   TestMatchingRecorder* recorder = nullptr;
 };
 
-GraphRun run_graph(int domain, double duration_s, const std::string& matching_params,
+GraphRun run_graph(double duration_s, const std::string& matching_params,
                    const std::string& source_params = "{}") {
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      ("avs_matching_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string file = (dir / "graph.yaml").string();
-  {
-    std::ofstream out(file);
-    out << "domain_id: " << domain << "\n"
-        << "clock: {source: sim, mode: lockstep, duration_s: " << duration_s << "}\n"
-        << "containers:\n"
-        << "  - name: matching\n"
-        << "    executor: single_threaded\n"
-        << "    components:\n"
-        << "      - {type: test_matching_source, name: source, parameters: " << source_params
-        << "}\n"
-        << "      - {type: matching, name: matching, parameters: " << matching_params << "}\n"
-        << "      - {type: test_matching_recorder, name: recorder}\n";
-  }
-  graph::LoadResult loaded = graph::load_graph(file, {});
-  std::filesystem::remove_all(dir);
-  for (const auto& e : loaded.errors) ADD_FAILURE() << e.str();
+  avs::testing::ContainerRun ran = avs::testing::run_lockstep_container(
+      {"{type: test_matching_source, name: source, parameters: " + source_params + "}",
+       "{type: matching, name: matching, parameters: " + matching_params + "}",
+       "{type: test_matching_recorder, name: recorder}"},
+      duration_s);
+  for (const auto& e : ran.load_errors) ADD_FAILURE() << e;
   GraphRun run;
-  if (!loaded.ok()) return run;
-  run.graph = std::make_unique<graph::Graph>(std::move(*loaded.graph));
-  run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
-  EXPECT_EQ(run.container->run(), 0);
-  run.source = dynamic_cast<TestMatchingSource*>(run.container->find_component("source"));
-  run.recorder = dynamic_cast<TestMatchingRecorder*>(run.container->find_component("recorder"));
+  if (!ran.container) return run;
+  EXPECT_EQ(ran.status, 0);
+  run.source = ran.find<TestMatchingSource>("source");
+  run.recorder = ran.find<TestMatchingRecorder>("recorder");
+  run.graph = std::move(ran.graph);
+  run.container = std::move(ran.container);
   EXPECT_NE(run.source, nullptr);
   EXPECT_NE(run.recorder, nullptr);
   return run;
@@ -244,7 +231,7 @@ double rotation_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
 }
 
 TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
-  GraphRun run = run_graph(150, 0.4, "{model: ken, publish_scene_points: true}");
+  GraphRun run = run_graph(0.4, "{model: ken, publish_scene_points: true}");
   ASSERT_NE(run.recorder, nullptr);
   const auto& depth = run.source->depth_stamps_ns;
   const auto& rec = *run.recorder;
@@ -301,7 +288,7 @@ TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
 }
 
 TEST(MatchingComponent, WithoutJointStatesOnlyTheCameraPoseIsPublished) {
-  GraphRun run = run_graph(151, 0.05,
+  GraphRun run = run_graph(0.05,
                            "{model: ken, joint_names: 'yaw,pitch'}");  // no such joints
   ASSERT_NE(run.recorder, nullptr);
   EXPECT_EQ(run.recorder->camera.size(), run.source->depth_stamps_ns.size());
@@ -329,11 +316,10 @@ double max_camera_error_mm(const GraphRun& run) {
 
 TEST(MatchingComponent, LagCompensationUsesTheDataAgeOfDepthInfo) {
   GraphRun with_info =
-      run_graph(153, 0.2, "{model: ken, lag_compensation_s: 0.05}", "{info_age_s: 0.0}");
+      run_graph(0.2, "{model: ken, lag_compensation_s: 0.05}", "{info_age_s: 0.0}");
   ASSERT_NE(with_info.recorder, nullptr);
-  GraphRun fixed =
-      run_graph(154, 0.2, "{model: ken, lag_compensation_s: 0.05, use_depth_info: false}",
-                "{info_age_s: 0.0}");
+  GraphRun fixed = run_graph(0.2, "{model: ken, lag_compensation_s: 0.05, use_depth_info: false}",
+                             "{info_age_s: 0.0}");
   ASSERT_NE(fixed.recorder, nullptr);
   const double with_info_mm = max_camera_error_mm(with_info);
   const double fixed_mm = max_camera_error_mm(fixed);
@@ -349,7 +335,8 @@ TEST(MatchingComponent, UnknownModelFailsTheContainerLoudly) {
                     ("avs_matching_bad_" + std::to_string(getpid()) + ".yaml");
   {
     std::ofstream out(file);
-    out << "domain_id: 152\nclock: {source: sim, mode: lockstep, duration_s: 0.01}\n"
+    out << "domain_id: " << avs::testing::test_domain()
+        << "\nclock: {source: sim, mode: lockstep, duration_s: 0.01}\n"
         << "containers:\n  - name: m\n    components:\n"
         << "      - {type: matching, name: matching, parameters: {model: /nonexistent.ply}}\n";
   }

@@ -4,6 +4,7 @@
 
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/qos.hpp"
+#include "avs/testing/test_domain.hpp"
 
 namespace avs::runtime {
 namespace {
@@ -39,7 +40,7 @@ TEST(TypeRegistryTest, KnowsRos2AndAvsTypesByDdsName) {
 }
 
 TEST(DdsEntityTest, InvalidTopicNameIsReportedWithTheName) {
-  dds::Participant participant;
+  dds::Participant participant(avs::testing::test_domain());
   const auto* type = msg::find_type("std_msgs::msg::dds_::String_");
   try {
     dds::Topic topic(participant, type->descriptor, "bad name with spaces?*", QosProfile{});
@@ -51,7 +52,7 @@ TEST(DdsEntityTest, InvalidTopicNameIsReportedWithTheName) {
 
 TEST(DdsEntityTest, WriterSeesNoMatchedReaderInItsOwnParticipant) {
   // Same-participant samples are delivered by the container, never through DDS.
-  dds::Participant participant;
+  dds::Participant participant(avs::testing::test_domain());
   const auto* type = msg::find_type("std_msgs::msg::dds_::String_");
   dds::Topic topic(participant, type->descriptor, "rt/avs_test_ignorelocal", QosProfile{});
   dds::Writer writer(participant, topic, QosProfile{});

@@ -2,7 +2,8 @@
 // recorder in the same container checks the published frame sequence (bit, polarity, cycle,
 // 1 ms stamps), the ground truth against the scene file and the head state, /timing, and
 // that two runs (the second with a thread busy-looping on the other core) give identical
-// ground truth and identical image checksums. DDS domains 130-134, Modbus ports 15130-15136.
+// ground truth and identical image checksums. DDS domain and Modbus ports leased per test
+// process (tests/support/include/avs/testing/test_domain.hpp).
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -23,6 +24,8 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
 #include "avs/sim/scene_yaml.hpp"
+#include "avs/testing/lockstep_graph.hpp"
+#include "avs/testing/test_domain.hpp"
 
 namespace avs::sim {
 namespace {
@@ -150,36 +153,24 @@ struct GraphRun {
   int status = -1;
 };
 
-/// Runs sim_amplifier + sim_scene + recorder for `duration_s` of sim time, lockstep.
-GraphRun run_graph(int domain, double duration_s, const std::string& scene_params,
+/// Runs sim_amplifier + sim_scene + recorder for `duration_s` of sim time, lockstep; the
+/// amplifier on `port` (default: this test's first port).
+GraphRun run_graph(double duration_s, const std::string& scene_params,
                    const std::string& amplifier_params, int port = 0) {
   setenv("AVS_SOURCE_DIR", AVS_TEST_SOURCE_DIR, 1);
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("avs_sim_graph_" + std::to_string(domain) + "_" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string file = (dir / "graph.yaml").string();
-  {
-    std::ofstream out(file);
-    out << "domain_id: " << domain << "\n"
-        << "clock: {source: sim, mode: lockstep, duration_s: " << duration_s << "}\n"
-        << "containers:\n"
-        << "  - name: sim\n"
-        << "    executor: single_threaded\n"
-        << "    components:\n"
-        << "      - {type: sim_amplifier, name: amplifier, parameters: {port: "
-        << (port != 0 ? port : 15000 + domain) << amplifier_params << "}}\n"
-        << "      - {type: sim_scene, name: scene, parameters: " << scene_params << "}\n"
-        << "      - {type: test_sim_recorder, name: recorder}\n";
-  }
-  graph::LoadResult loaded = graph::load_graph(file, {});
-  std::filesystem::remove_all(dir);
-  for (const auto& e : loaded.errors) ADD_FAILURE() << e.str();
+  if (port == 0) port = avs::testing::test_tcp_port(0);
+  avs::testing::ContainerRun ran = avs::testing::run_lockstep_container(
+      {"{type: sim_amplifier, name: amplifier, parameters: {port: " + std::to_string(port) +
+           amplifier_params + "}}",
+       "{type: sim_scene, name: scene, parameters: " + scene_params + "}",
+       "{type: test_sim_recorder, name: recorder}"},
+      duration_s);
+  for (const auto& e : ran.load_errors) ADD_FAILURE() << e;
   GraphRun run;
-  if (!loaded.ok()) return run;
-  run.graph = std::make_unique<graph::Graph>(std::move(*loaded.graph));
-  run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
-  run.status = run.container->run();
-  run.recorder = dynamic_cast<TestSimRecorder*>(run.container->find_component("recorder"));
+  run.status = ran.status;
+  run.recorder = ran.find<TestSimRecorder>("recorder");
+  run.graph = std::move(ran.graph);
+  run.container = std::move(ran.container);
   return run;
 }
 
@@ -192,7 +183,7 @@ const std::string kFallingTilt =
 constexpr double kDurationS = 0.15;
 
 TEST(SimSceneGraph, FramesCarryTheGrayCodeScheduleAndGroundTruthMatchesSceneAndHead) {
-  const GraphRun run = run_graph(130, kDurationS, kSwingScene, kFallingTilt);
+  const GraphRun run = run_graph(kDurationS, kSwingScene, kFallingTilt);
   ASSERT_EQ(run.status, 0);
   ASSERT_NE(run.recorder, nullptr);
   const auto& frames = run.recorder->frames;
@@ -267,7 +258,7 @@ TEST(SimSceneGraph, FramesCarryTheGrayCodeScheduleAndGroundTruthMatchesSceneAndH
 }
 
 TEST(SimSceneGraph, LockstepRunsAreIdenticalWithTheOtherCoreBusy) {
-  const GraphRun quiet = run_graph(131, kDurationS, kSwingScene, kFallingTilt);
+  const GraphRun quiet = run_graph(kDurationS, kSwingScene, kFallingTilt);
   std::atomic<bool> stop{false};
   std::thread busy([&stop] {
     volatile std::uint64_t x = 0;
@@ -275,7 +266,8 @@ TEST(SimSceneGraph, LockstepRunsAreIdenticalWithTheOtherCoreBusy) {
   });
   // Each run's amplifier listens until its container is destroyed: other ports (135-136 of
   // our 130-139 range).
-  const GraphRun loaded = run_graph(131, kDurationS, kSwingScene, kFallingTilt, 15135);
+  const GraphRun loaded =
+      run_graph(kDurationS, kSwingScene, kFallingTilt, avs::testing::test_tcp_port(1));
   stop = true;
   busy.join();
   ASSERT_EQ(quiet.status, 0);
@@ -286,8 +278,8 @@ TEST(SimSceneGraph, LockstepRunsAreIdenticalWithTheOtherCoreBusy) {
   EXPECT_TRUE(quiet.recorder->frames == loaded.recorder->frames) << "frames or checksums differ";
   EXPECT_TRUE(quiet.recorder->truths == loaded.recorder->truths) << "ground truth differs";
   // A different seed changes the images (noise), not the ground truth.
-  const GraphRun other =
-      run_graph(131, kDurationS, "{scene: swing, start_time_s: 0.6, seed: 8}", kFallingTilt, 15136);
+  const GraphRun other = run_graph(kDurationS, "{scene: swing, start_time_s: 0.6, seed: 8}",
+                                   kFallingTilt, avs::testing::test_tcp_port(2));
   ASSERT_NE(other.recorder, nullptr);
   ASSERT_EQ(other.recorder->frames.size(), quiet.recorder->frames.size());
   EXPECT_NE(other.recorder->frames[5].checksum, quiet.recorder->frames[5].checksum);
@@ -297,7 +289,7 @@ TEST(SimSceneGraph, LockstepRunsAreIdenticalWithTheOtherCoreBusy) {
 TEST(SimSceneGraph, BuiltInSceneWithObjectTrajectoryAndDistanceOverrides) {
   // Built-in scene, the target replaced by the cube swinging at 2 m/s peak, 0.8 m away.
   const GraphRun run =
-      run_graph(132, 0.02,
+      run_graph(0.02,
                 "{object: cube, trajectory: swing, swing_speed_m_s: 2.0, distance_m: 0.8, "
                 "noise_sigma_dn: 0}",
                 "");
@@ -319,12 +311,12 @@ TEST(SimSceneGraph, BuiltInSceneWithObjectTrajectoryAndDistanceOverrides) {
 }
 
 TEST(SimSceneGraph, UnknownSceneFailsTheContainerWithTheTriedPaths) {
-  const GraphRun run = run_graph(133, 0.01, "{scene: no_such_scene}", "");
+  const GraphRun run = run_graph(0.01, "{scene: no_such_scene}", "");
   EXPECT_EQ(run.status, 1);
 }
 
 TEST(SimSceneGraph, SwingSpeedOnAStaticSceneIsAnError) {
-  const GraphRun run = run_graph(134, 0.01, "{scene: static_ken, swing_speed_m_s: 1.0}", "");
+  const GraphRun run = run_graph(0.01, "{scene: static_ken, swing_speed_m_s: 1.0}", "");
   EXPECT_EQ(run.status, 1);
 }
 
