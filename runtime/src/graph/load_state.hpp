@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "yaml_reader.hpp"
+#include "avs/graph/yaml_reader.hpp"
 
 namespace avs::graph::detail {
 

@@ -11,7 +11,7 @@
 #include <set>
 #include <sstream>
 
-#include "../graph/yaml_reader.hpp"
+#include "avs/graph/yaml_reader.hpp"
 
 namespace avs::deploy {
 namespace {

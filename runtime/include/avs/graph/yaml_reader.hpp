@@ -1,5 +1,6 @@
-// Internal to the graph loader: reading YAML nodes with locations, argument and
-// environment substitution, and error collection. Not a public header.
+// Reading YAML files with source locations (file:line:col in every error), argument and
+// environment substitution, and error collection: the one YAML reader of the graph loader and
+// the deployment loader (libs/deploy). Errors are collected, never thrown one at a time.
 #pragma once
 
 #include <cstdint>
