@@ -24,6 +24,7 @@
 #include "avs/deploy/publisher_watch.hpp"
 #include "avs/deploy/roudi.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/process.hpp"
 #include "commands.hpp"
 #include "graph_loading.hpp"
 
@@ -67,9 +68,11 @@ pid_t spawn(const ChildPlan& plan, const sigset_t& original_mask) {
   std::vector<char*> envp;
   for (auto& e : env_s) envp.push_back(e.data());
   envp.push_back(nullptr);
+  const pid_t launcher = getpid();
   const pid_t pid = fork();
   if (pid < 0) throw std::runtime_error(std::string("fork: ") + std::strerror(errno));
   if (pid == 0) {
+    runtime::die_with_parent(launcher);
     sigprocmask(SIG_SETMASK, &original_mask, nullptr);
     execve("/proc/self/exe", argv.data(), envp.data());
     static const char msg[] = "avs launch: exec of /proc/self/exe failed\n";

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "avs/runtime/error.hpp"
+#include "avs/runtime/process.hpp"
 
 namespace avs::deploy {
 namespace {
@@ -109,9 +110,11 @@ Roudi::Roudi(double timeout_s) {
   const std::string log_path = config_dir_ + "/roudi.log";
   const int log_fd = open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (log_fd < 0) throw runtime::Error("cannot create " + log_path);
+  const pid_t launcher = getpid();
   pid_ = fork();
   if (pid_ < 0) throw runtime::Error("fork for iox-roudi failed");
   if (pid_ == 0) {
+    runtime::die_with_parent(launcher);
     // RouDi's output goes to a file: it says when it is ready for clients.
     dup2(log_fd, 1);
     dup2(log_fd, 2);
