@@ -259,22 +259,24 @@ void add_bag_command(Command& app) {
       ->capture_default_str();
   record->add_option("--max-size", rec.options.max_size_bytes,
                      "start a new file (<stem>_1.mcap, ...) when one reaches BYTES (0: never)");
-  record->add_option("--max-duration", rec.options.max_duration_s,
-                     "start a new file when one covers S seconds (0: never)");
+  record
+      ->add_option("--max-duration", rec.options.max_duration_s,
+                   "start a new file when one covers S seconds (0: never)")
+      ->check_range(0, 1e9);
   record
       ->add_option("--queue-size", rec.queue_mb,
                    "MB of samples waiting for the writer before samples are dropped (and counted)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0, 1e6);
   record
       ->add_option("--flush-interval", rec.options.flush_interval_s,
                    "close the open chunk at least this often, s (bounds what a kill loses)")
-      ->capture_default_str();
-  record->add_option("--duration", rec.duration_s,
-                     "stop after S seconds (0: until Ctrl-C/SIGTERM)");
-  rec.options.domain = domain_or_environment(0);
+      ->capture_default_str()
+      ->check_range(0.001, 3600);
+  record->add_option("--duration", rec.duration_s, "stop after S seconds (0: until Ctrl-C/SIGTERM)")
+      ->check_range(0, 1e9);
   rec.options.partition = environment_partition();
-  record->add_option("--domain", rec.options.domain,
-                     "DDS domain id (default: $AVS_DOMAIN_ID or 0)");
+  add_domain_option(record, rec.options.domain);
   record->footer(
       "Exit status: 0 all received samples written; 3 some were lost (listed); 1 error.");
   record->callback([] { exit_status() = run_record(rec); });
@@ -283,10 +285,13 @@ void add_bag_command(Command& app) {
   auto* play = bag->add_subcommand(
       "play", "Republish a recording with its timing and QoS (space: pause/resume)");
   play->add_option("file", pl.options.file, "MCAP file")->required();
-  play->add_option("-r,--rate", pl.options.rate, "playback speed factor")->capture_default_str();
+  play->add_option("-r,--rate", pl.options.rate, "playback speed factor")
+      ->capture_default_str()
+      ->check_range(1e-3, 1e3);
   play->add_flag("-l,--loop", pl.options.loop, "start again at the end");
   play->add_option("--start-offset", pl.options.start_offset_s,
-                   "skip the first S seconds of the bag");
+                   "skip the first S seconds of the bag")
+      ->check_range(0, 1e9);
   play->add_option("--topics", pl.options.topics, "play only these topics");
   play->add_option("--remap", pl.remaps, "publish topic FROM as TO (FROM:=TO), repeatable");
   play->add_flag(
@@ -295,13 +300,14 @@ void add_bag_command(Command& app) {
       "follows the recording");
   play->add_option("--clock-period", pl.options.clock_period_s,
                    "with --clock: publish /clock at least every S seconds of bag time")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1e-6, 3600);
   play->add_option("--delay", pl.options.delay_s,
                    "wait S seconds after creating the writers (discovery)")
-      ->capture_default_str();
-  pl.options.domain = domain_or_environment(0);
+      ->capture_default_str()
+      ->check_range(0, 3600);
   pl.options.partition = environment_partition();
-  play->add_option("--domain", pl.options.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)");
+  add_domain_option(play, pl.options.domain);
   play->callback([] { exit_status() = run_play(pl); });
 
   static std::string info_file;

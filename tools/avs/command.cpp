@@ -1,9 +1,29 @@
 // The CLI11 facade of command.hpp: the one file of the `avs` program that compiles CLI11.
 #include "command.hpp"
 
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
 #include <CLI/CLI.hpp>
 
 namespace avs::cli {
+namespace {
+
+/// Every floating-point option refuses NaN and the infinities (`--wait nan` used to wait
+/// forever, `--rate inf` to spin): the option's range, if any, is checked after this.
+CLI::Validator finite_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return {};  // not a number: CLI11 says so
+        return std::isfinite(v) ? std::string() : "a finite number is needed, got " + text;
+      },
+      "", "FINITE");
+}
+
+}  // namespace
 
 Option* Option::required() {
   option_->required();
@@ -64,7 +84,8 @@ Option* Command::add_option(std::string name, std::filesystem::path& value,
 }
 
 Option* Command::add_option(std::string name, double& value, std::string description) {
-  return keep(app_->add_option(std::move(name), value, std::move(description)));
+  return keep(
+      app_->add_option(std::move(name), value, std::move(description))->check(finite_number()));
 }
 
 Option* Command::add_option(std::string name, int& value, std::string description) {
@@ -119,6 +140,22 @@ std::size_t Command::count(const std::string& name) const { return app_->count(n
 void Command::parse(int argc, const char* const* argv) { app_->parse(argc, argv); }
 
 std::optional<int> Command::parse_or_explain(int argc, const char* const* argv) {
+  // A first word that is no command: say so and list the commands (CLI11 would only say
+  // "A subcommand is required").
+  if (argc > 1 && argv[1][0] != '-') {
+    const auto all = app_->get_subcommands([](CLI::App*) { return true; });
+    bool known = all.empty();
+    std::string names;
+    for (const CLI::App* sub : all) {
+      known = known || sub->check_name(argv[1]);
+      if (!sub->get_group().empty()) names += (names.empty() ? "" : ", ") + sub->get_name();
+    }
+    if (!known) {
+      std::cerr << "avs: unknown command '" << argv[1] << "'; commands: " << names
+                << " (--help says more)\n";
+      return 2;
+    }
+  }
   try {
     app_->parse(argc, argv);
   } catch (const CLI::ParseError& e) {

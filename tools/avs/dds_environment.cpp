@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include "avs/runtime/error.hpp"
+#include "command.hpp"
 
 namespace avs::cli {
 
@@ -25,6 +26,13 @@ int domain_or_environment(int fallback) {
 std::string environment_partition() {
   const char* env = std::getenv("AVS_PARTITION");
   return env != nullptr ? env : "";
+}
+
+Option* add_domain_option(Command* cmd, int& domain) {
+  domain = domain_or_environment(0);
+  return cmd->add_option("--domain", domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")
+      ->capture_default_str()
+      ->check_range(0, 232);
 }
 
 void apply_environment(graph::Graph& g) {

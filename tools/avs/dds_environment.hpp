@@ -22,6 +22,13 @@ int domain_or_environment(int fallback);
 /// $AVS_PARTITION, "" when unset.
 std::string environment_partition();
 
+class Command;
+class Option;
+
+/// The --domain option of a command: `domain` set to $AVS_DOMAIN_ID (or 0) as its default,
+/// values in [0, 232].
+Option* add_domain_option(Command* cmd, int& domain);
+
 /// A loaded graph as the shell asks for it: its domain_id replaced by $AVS_DOMAIN_ID, its
 /// partition set from $AVS_PARTITION.
 void apply_environment(graph::Graph& g);

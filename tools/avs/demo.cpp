@@ -30,7 +30,9 @@ void add_demo_command(Command& app) {
   static ClosedLoopRun run;
   static std::string out;
   static bool no_tracking = false;
-  cmd->add_option("--seconds", run.duration_s, "simulated time to run")->capture_default_str();
+  cmd->add_option("--seconds", run.duration_s, "simulated time to run")
+      ->capture_default_str()
+      ->check_range(0.01, 3600);
   cmd->add_option("--out", out, "run folder (default avs-runs/demo-<date>)");
   cmd->add_option("--scene", run.scene, "scene: a name in launch_config/scenes/ or a YAML file")
       ->capture_default_str();

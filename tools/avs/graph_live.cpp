@@ -147,13 +147,13 @@ std::vector<std::string> mismatch(const Endpoint& pub, const Endpoint& sub) {
 }
 
 struct Options {
-  int domain = -1;
+  int domain = 0;  // add_domain_option
   double duration_s = 3.0;
   bool rates = true;
 };
 
 int run_graph_view(const Options& o) {
-  const int domain = o.domain >= 0 ? o.domain : domain_or_environment(0);
+  const int domain = o.domain;
   runtime::dds::Participant participant(static_cast<dds_domainid_t>(domain),
                                         environment_partition());
   const std::string self = [&] {
@@ -366,10 +366,11 @@ void add_graph_command(Command& app) {
       "graph",
       "Live graph: components and health, topics with rates, QoS mismatches named plainly");
   static Options o;
-  cmd->add_option("--domain", o.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)");
+  add_domain_option(cmd, o.domain);
   cmd->add_option("--duration", o.duration_s,
                   "seconds to observe (rates are measured in the second half)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0.1, 3600);
   cmd->add_flag("!--no-rates", o.rates, "do not subscribe to topics to measure rates");
   cmd->footer(
       "Exit status 3 when a publisher and a subscriber of one topic cannot match.\n"

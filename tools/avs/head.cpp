@@ -21,7 +21,7 @@ namespace avs::cli {
 namespace {
 
 struct ResetOptions {
-  int domain = domain_or_environment(0);
+  int domain = 0;  // add_domain_option
   double wait_s = 5.0;
   std::string topic;  // empty: servo_drive's default topic
 };
@@ -81,11 +81,12 @@ void add_head_command(Command& app) {
       "reset",
       "Request a fault reset: servo_drive resets drives in Fault and, once they have been "
       "Operation enabled for fault_clear_stable_cycles, applies torque again (docs/servo.md)");
-  reset->add_option("--domain", options.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")
-      ->capture_default_str();
-  reset->add_option("--wait", options.wait_s,
-                    "seconds to wait for a subscriber and for its acknowledgement")
-      ->capture_default_str();
+  add_domain_option(reset, options.domain);
+  reset
+      ->add_option("--wait", options.wait_s,
+                   "seconds to wait for a subscriber and for its acknowledgement")
+      ->capture_default_str()
+      ->check_range(0, 3600);
   reset->add_option("--topic", options.topic,
                     "topic, if remapped in the graph (default: servo_drive's /head/fault_reset)");
   reset->callback([] { exit_status() = run_reset(options); });

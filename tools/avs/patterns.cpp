@@ -115,8 +115,12 @@ void add_patterns_command(Command& app) {
       ->capture_default_str();
   cmd->add_option("--first-row", o.first_row,
                   "projector row where code 0 starts (default: coded rows centred)");
-  cmd->add_option("--width", o.width, "projector width, pixels")->capture_default_str();
-  cmd->add_option("--height", o.height, "projector height, pixels")->capture_default_str();
+  cmd->add_option("--width", o.width, "projector width, pixels")
+      ->capture_default_str()
+      ->check_range(1, 16384);
+  cmd->add_option("--height", o.height, "projector height, pixels")
+      ->capture_default_str()
+      ->check_range(1, 16384);
   cmd->callback([cmd] {
 #ifdef AVS_HAVE_DECODE
     try {

@@ -22,8 +22,12 @@ void add_report_command(Command& app) {
   static int height_px = 650;
   static std::string gnuplot = "gnuplot";
   cmd->add_option("DIR", dir, "run folder (frames.csv, meta.csv, ...)")->required();
-  cmd->add_option("--width", width_px, "figure width in pixels")->capture_default_str();
-  cmd->add_option("--height", height_px, "figure height in pixels")->capture_default_str();
+  cmd->add_option("--width", width_px, "figure width in pixels")
+      ->capture_default_str()
+      ->check_range(100, 10000);
+  cmd->add_option("--height", height_px, "figure height in pixels")
+      ->capture_default_str()
+      ->check_range(100, 10000);
   cmd->add_option("--gnuplot", gnuplot, "gnuplot program")->capture_default_str();
   cmd->callback([] {
 #ifdef AVS_HAVE_REPORT

@@ -66,6 +66,23 @@ void on_interrupt(int) {
   g_interrupted = 1;
 }
 
+/// Ctrl-C and SIGTERM end a topic command cleanly (the wait for a publisher too). Installed
+/// when a topic command runs, not when it is registered: other commands keep the defaults.
+void handle_interrupts() {
+  std::signal(SIGINT, on_interrupt);
+  std::signal(SIGTERM, on_interrupt);
+}
+
+/// Sleeps `wait`, in slices, until it is over or an interrupt came; throws on the interrupt.
+void sleep_unless_interrupted(std::chrono::milliseconds wait) {
+  const auto end = Clock::now() + wait;
+  while (Clock::now() < end) {
+    if (g_interrupted) throw runtime::Error("interrupted");
+    std::this_thread::sleep_for(
+        std::min<Clock::duration>(std::chrono::milliseconds(50), end - Clock::now()));
+  }
+}
+
 /// Reads the built-in publication/subscription topics for `wait`, skipping our own.
 std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& participant,
                                           std::chrono::milliseconds wait) {
@@ -75,7 +92,7 @@ std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& parti
   runtime::dds::Entity subs(runtime::check_dds(
       dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr),
       "read DCPSSubscription"));
-  std::this_thread::sleep_for(wait);
+  sleep_unless_interrupted(wait);
   dds_guid_t own{};
   runtime::check_dds(dds_get_guid(participant.get(), &own), "participant guid");
 
@@ -183,7 +200,7 @@ class RawReader {
 
 struct CommonOptions {
   std::string topic;
-  int domain = domain_or_environment(0);
+  int domain = 0;  // add_domain_option
   double wait_s = 5.0;
   double duration_s = 0;  // 0 = until Ctrl-C
   long count = 0;         // 0 = unlimited
@@ -191,10 +208,12 @@ struct CommonOptions {
 
 void add_common(Command* cmd, CommonOptions& o, bool needs_topic) {
   if (needs_topic) cmd->add_option("topic", o.topic, "topic: /name, name or rt/name")->required();
-  cmd->add_option("--domain", o.domain, "DDS domain id (default: $AVS_DOMAIN_ID or 0)")
-      ->capture_default_str();
-  cmd->add_option("--wait", o.wait_s, "seconds to wait for a publisher")->capture_default_str();
-  cmd->add_option("--duration", o.duration_s, "stop after this many seconds (0: until Ctrl-C)");
+  add_domain_option(cmd, o.domain);
+  cmd->add_option("--wait", o.wait_s, "seconds to wait for a publisher")
+      ->capture_default_str()
+      ->check_range(0, 3600);
+  cmd->add_option("--duration", o.duration_s, "stop after this many seconds (0: until Ctrl-C)")
+      ->check_range(0, 1e9);
 }
 
 bool should_stop(const CommonOptions& o, Clock::time_point start) {
@@ -303,8 +322,6 @@ void add_topic_command(Command& app) {
   auto* topic =
       app.add_subcommand("topic", "Inspect topics of running graphs (any process, any host)");
   topic->require_subcommand(1);
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
 
   static CommonOptions list_o;
   static bool verbose = false;
@@ -313,7 +330,10 @@ void add_topic_command(Command& app) {
       "list", "Topics seen through DDS discovery, with types and endpoint counts");
   add_common(list, list_o, false);
   list->add_flag("-v,--verbose", verbose, "show DDS type names and each endpoint's QoS");
-  list->callback([] { run_list(list_o, verbose); });
+  list->callback([] {
+    handle_interrupts();
+    run_list(list_o, verbose);
+  });
 
   static CommonOptions echo_o;
   static introspection::YamlOptions yaml;
@@ -323,7 +343,10 @@ void add_topic_command(Command& app) {
   echo->add_option("-n,--count", echo_o.count, "print this many samples, then exit");
   echo->add_option("--max-elements", yaml.max_list_elements,
                    "longest list printed in full (0: all)");
-  echo->callback([] { run_echo(echo_o, yaml); });
+  echo->callback([] {
+    handle_interrupts();
+    run_echo(echo_o, yaml);
+  });
 
   static CommonOptions hz_o;
   static std::size_t hz_window = 1000;
@@ -331,14 +354,20 @@ void add_topic_command(Command& app) {
   add_common(hz, hz_o, true);
   hz->add_option("-w,--window", hz_window, "intervals in the sliding window")
       ->capture_default_str();
-  hz->callback([] { run_rate(hz_o, false, hz_window); });
+  hz->callback([] {
+    handle_interrupts();
+    run_rate(hz_o, false, hz_window);
+  });
 
   static CommonOptions bw_o;
   static std::size_t bw_window = 1000;
   auto* bw = topic->add_subcommand("bw", "Bandwidth: bytes per second of serialised samples");
   add_common(bw, bw_o, true);
   bw->add_option("-w,--window", bw_window, "messages in the sliding window")->capture_default_str();
-  bw->callback([] { run_rate(bw_o, true, bw_window); });
+  bw->callback([] {
+    handle_interrupts();
+    run_rate(bw_o, true, bw_window);
+  });
 }
 
 }  // namespace avs::cli

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Issue 20 section 2, command line: an unknown command is named with the list of commands; NaN,
+# infinite and out-of-range numbers are refused with the option's name (they used to wait or
+# spin forever); Ctrl-C ends a topic command while it waits for a publisher.
+set -uo pipefail
+avs=$1; src=$2
+. "$src/tests/integration/lib.sh"
+refused() {  # refused "what the error must say" ARGS...: exit status 2..109 and the message
+  local want=$1; shift
+  local err status
+  err=$(timeout 10 "$avs" "$@" 2>&1 >/dev/null); status=$?
+  ((status != 0 && status != 124)) || fail "avs $* was accepted (status $status)"
+  grep -qF -- "$want" <<<"$err" || fail "avs $*: expected '$want' in: $err"
+  echo "ok: avs $* -> $(head -n 1 <<<"$err")"
+}
+refused "unknown command 'nosuchcmd'; commands: demo" nosuchcmd
+refused "--wait: a finite number is needed, got nan" topic echo /chatter --wait nan
+refused "--wait: Value -1 not in range" topic hz /chatter --wait -1
+refused "--rate: a finite number is needed, got inf" bag play none.mcap --rate inf
+refused "--domain: Value 300 not in range" topic list --domain 300
+refused "--width: Value 100000 not in range" patterns --width 100000 --out /nonexistent
+refused "--seconds: a finite number is needed, got inf" demo --seconds inf
+
+"$avs" topic echo /no_such_topic --wait 60 >/dev/null 2>&1 &
+pid=$!
+sleep 1
+kill -INT "$pid"
+for _ in $(seq 30); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
+if kill -0 "$pid" 2>/dev/null; then kill -9 "$pid"; fail "Ctrl-C did not end 'topic echo --wait 60' within 3 s"; fi
+echo "ok: Ctrl-C ends the wait for a publisher"
+echo PASS
