@@ -2,6 +2,8 @@
 #include <random>
 #include <stdexcept>
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include "avs/matching/distance_grid.hpp"
@@ -170,6 +172,22 @@ TEST(DistanceGrid, AgreesWithTheClosestPoint) {
   EXPECT_LE(large.cells(), (1U << 20) + (1U << 18));  // + the boundary corners
   EXPECT_NEAR(large.nearest_distance(Eigen::Vector3f(2.0F, 2.0F, 2.01F)), 0.01F, large.cell_m());
   EXPECT_THROW(DistanceGrid(model.dense_points_m, 0.0F, truncation), std::invalid_argument);
+}
+
+TEST(DistanceGrid, StaysWithinItsLimitForAFlatHugeMesh) {
+  // Issue 20 section 2: a model scaled by 1e12 made the InitialAligner's grid spin at load. A flat
+  // object is the worst case: the cell grown from the volume leaves the thin axis at a few
+  // corners while the other two keep millions (7e13 corners for this square).
+  constexpr float kSide = 1e12F;
+  const Points flat{
+      {0.0F, 0.0F, 0.0F}, {kSide, 0.0F, 0.0F}, {0.0F, kSide, 0.0F}, {kSide, kSide, 0.0F}};
+  constexpr std::size_t kMax = 1U << 20;
+  const DistanceGrid grid(flat, 0.002F, 0.01F, kMax);
+  EXPECT_LE(grid.cells(), kMax);
+  // Non-finite coordinates are refused, not rasterised.
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(DistanceGrid(Points{{0.0F, 0.0F, 0.0F}, {nan, 0.0F, 0.0F}}, 0.002F, 0.01F),
+               std::invalid_argument);
 }
 
 }  // namespace

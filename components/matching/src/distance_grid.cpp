@@ -24,6 +24,7 @@ DistanceGrid::DistanceGrid(const Points& points_m, float cell_m, float truncatio
   Eigen::Vector3f low = points_m.front();
   Eigen::Vector3f high = points_m.front();
   for (const auto& p : points_m) {
+    if (!p.allFinite()) throw std::invalid_argument("DistanceGrid: a point is not finite");
     low = low.cwiseMin(p);
     high = high.cwiseMax(p);
   }
@@ -36,12 +37,25 @@ DistanceGrid::DistanceGrid(const Points& points_m, float cell_m, float truncatio
     cell_m_ = static_cast<float>(std::cbrt(volume / static_cast<double>(max_cells)));
     inverse_cell_ = 1.0F / cell_m_;
   }
+  // Corners per axis, counted in double: at 1e12 m over millimetre cells a float or size_t
+  // product would overflow.
   const auto corners = [&](float length) {
-    return static_cast<std::size_t>(std::ceil(length * inverse_cell_)) + 2;
+    return std::ceil(static_cast<double>(length) / static_cast<double>(cell_m_)) + 2.0;
   };
-  nx_ = corners(extent.x());
-  ny_ = corners(extent.y());
-  nz_ = corners(extent.z());
+  // The volume rule undercounts a flat or thin object (its thin axes keep their boundary
+  // corners whatever the cell): grow the cell until the real count fits. Each step removes
+  // about half the corners, so this ends within a few dozen steps (issue 20: a mesh scaled by
+  // 1e12 spun here).
+  // (Once the cell exceeds the largest extent every axis has 3 corners: the loop stops there.)
+  while (max_cells > 0 && cell_m_ < extent.maxCoeff() &&
+         corners(extent.x()) * corners(extent.y()) * corners(extent.z()) >
+             static_cast<double>(max_cells)) {
+    cell_m_ *= 1.26F;
+    inverse_cell_ = 1.0F / cell_m_;
+  }
+  nx_ = static_cast<std::size_t>(corners(extent.x()));
+  ny_ = static_cast<std::size_t>(corners(extent.y()));
+  nz_ = static_cast<std::size_t>(corners(extent.z()));
   limit_ = Eigen::Vector3f(static_cast<float>(nx_ - 1), static_cast<float>(ny_ - 1),
                            static_cast<float>(nz_ - 1));
   values_.assign(nx_ * ny_ * nz_, 255);

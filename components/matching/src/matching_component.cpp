@@ -162,6 +162,7 @@ class MatchingComponent final : public runtime::Component {
         use_depth_info_(ctx.param<bool>("use_depth_info")) {
     const ObjectModel object =
         load_object_model(ctx.param<std::string>("model"), ctx.param<std::string>("models_dir"));
+    warn_if_implausible(object);
     ModelCloudConfig model_config;
     const auto model_points = ctx.param<std::int64_t>("model_points");
     model_config.target_points =
@@ -222,6 +223,28 @@ class MatchingComponent final : public runtime::Component {
   }
 
  private:
+  /// A model whose size is far from the objects a 0.3-1.5 m depth window can see is most
+  /// likely in the wrong unit (millimetres for metres): said at start-up, since matching it
+  /// would fail without an error (issue 20 section 2). Non-finite vertices are refused.
+  void warn_if_implausible(const ObjectModel& object) {
+    if (object.mesh.vertices.empty()) return;
+    Eigen::Vector3f low = object.mesh.vertices.front();
+    Eigen::Vector3f high = low;
+    for (const auto& v : object.mesh.vertices) {
+      if (!v.allFinite()) {
+        throw std::invalid_argument("model '" + object.name + "' (" + object.mesh_path +
+                                    ") has a vertex that is not finite");
+      }
+      low = low.cwiseMin(v);
+      high = high.cwiseMax(v);
+    }
+    const double size_m = static_cast<double>((high - low).norm());
+    if (size_m < 0.005 || size_m > 5.0) {
+      log().warn("model '", object.name, "' (", object.mesh_path, ") is ", size_m,
+                 " m across: implausible for a 0.3-1.5 m depth window; is the mesh in metres?");
+    }
+  }
+
   void on_joints(const msgs::sensor_msgs::JointState& m) {
     std::optional<double> q[2];
     for (std::size_t axis = 0; axis < 2; ++axis) {
