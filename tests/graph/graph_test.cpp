@@ -4,6 +4,9 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+
+#include <unistd.h>
 
 #include "avs/graph/graph.hpp"
 #include "avs/msg/type_support.hpp"
@@ -284,6 +287,54 @@ TEST_F(GraphTest, MissingTopLevelFile) {
   const LoadResult result = load_graph(data("bad/no_such_file.yaml"), {});
   ASSERT_EQ(result.errors.size(), 1u) << all_errors(result);
   EXPECT_NE(result.errors[0].message.find("cannot open"), std::string::npos);
+}
+
+// ---- limits (issue 20 section 2) ----------------------------------------------------------
+
+TEST_F(GraphTest, SecondYamlDocumentIsAnErrorNotIgnored) {
+  expect_one_error("two_documents.yaml", 6, 1, {"second YAML document"});
+}
+
+/// A fresh folder for generated graphs, removed with the object.
+struct TempDir {
+  std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("avs_graph_limits_" + std::to_string(getpid()));
+  TempDir() { std::filesystem::create_directories(path); }
+  ~TempDir() { std::filesystem::remove_all(path); }
+};
+
+TEST_F(GraphTest, DeepIncludeChainIsALocatedErrorNotACrash) {
+  // 4000 nested includes overflowed the loader's stack (SIGSEGV); the limit is 64.
+  const TempDir dir;
+  constexpr int kFiles = 300;
+  for (int i = 0; i < kFiles; ++i) {
+    std::ofstream out(dir.path / ("g" + std::to_string(i) + ".yaml"));
+    if (i + 1 < kFiles) {
+      out << "include:\n  - {file: g" << i + 1 << ".yaml}\n";
+    } else {
+      out << "containers:\n  - name: box\n    components:\n"
+          << "      - {type: fake_talker, name: talker}\n";
+    }
+  }
+  const LoadResult result = load_graph((dir.path / "g0.yaml").string(), {});
+  ASSERT_EQ(result.errors.size(), 1u) << all_errors(result);
+  EXPECT_NE(result.errors[0].message.find("nested deeper than 64"), std::string::npos)
+      << result.errors[0].str();
+  EXPECT_EQ(result.errors[0].where.line, 2);
+}
+
+TEST_F(GraphTest, HugeValuesAreNotEchoedWhole) {
+  const TempDir dir;
+  const std::string type(100000, 'x');
+  {
+    std::ofstream out(dir.path / "huge.yaml");
+    out << "containers:\n  - name: box\n    components:\n      - {type: " << type
+        << ", name: talker}\n";
+  }
+  const LoadResult result = load_graph((dir.path / "huge.yaml").string(), {});
+  ASSERT_EQ(result.errors.size(), 1u);
+  EXPECT_LT(result.errors[0].message.size(), 2100u);
+  EXPECT_NE(result.errors[0].message.find("more characters)"), std::string::npos);
 }
 
 // ---- good graphs ----------------------------------------------------------------------

@@ -13,6 +13,11 @@ namespace avs::graph {
 namespace detail {
 namespace {
 
+/// Bounds of what a graph may be (issue 20: a 4000-file include chain overflowed the stack;
+/// a huge file ended in a bare std::bad_alloc).
+constexpr std::size_t kMaxIncludeDepth = 64;
+constexpr std::uintmax_t kMaxFileBytes = 16u << 20;
+
 namespace fs = std::filesystem;
 
 const std::vector<std::string> top_keys = {"args",  "namespace", "domain_id",
@@ -173,6 +178,14 @@ void read_includes(LoadState& state, const FileReader& reader, const YAML::Node&
         }
       }
     }
+    if (state.include_stack.size() >= kMaxIncludeDepth) {
+      reader.error(file_entry->value,
+                   "include 'file': includes nested deeper than " +
+                       std::to_string(kMaxIncludeDepth) + " files (from " +
+                       fs::path(state.include_stack.front()).filename().string() +
+                       "); is this include chain intended?");
+      continue;
+    }
     state.include_stack.push_back(canonical);
     load_file(state, resolved.string(), child_args, false);
     state.include_stack.pop_back();
@@ -185,10 +198,30 @@ std::optional<YAML::Node> parse_yaml(LoadState& state, const std::string& path) 
     state.diags.error({path, 1, 1}, "cannot open graph file '" + path + "'");
     return std::nullopt;
   }
+  std::error_code ec;
+  const auto size = fs::file_size(path, ec);
+  if (!ec && size > kMaxFileBytes) {
+    state.diags.error({path, 1, 1}, "graph file is " + std::to_string(size) +
+                                        " bytes, more than the limit of " +
+                                        std::to_string(kMaxFileBytes) + " for a graph");
+    return std::nullopt;
+  }
   std::stringstream text;
   text << in.rdbuf();
   try {
-    return YAML::Load(text.str());
+    // Every document is read so that a second one ('---') is an error, not silently ignored.
+    std::vector<YAML::Node> documents = YAML::LoadAll(text.str());
+    if (documents.empty()) return YAML::Node();
+    if (documents.size() > 1) {
+      const YAML::Mark mark = documents[1].Mark();
+      state.diags.error(
+          mark.is_null() ? SourceLocation{path, 1, 1}
+                         : SourceLocation{path, mark.line + 1, mark.column + 1},
+          "a second YAML document in a graph file (after '---'); a graph is one document, "
+          "use 'include' for more files");
+      return std::nullopt;
+    }
+    return documents.front();
   } catch (const YAML::Exception& e) {
     const SourceLocation where = e.mark.is_null()
                                      ? SourceLocation{path, 1, 1}

@@ -19,9 +19,16 @@ namespace avs::graph::detail {
 /// Collects every error; loading goes on after an error so all of them are reported.
 class Diagnostics {
  public:
+  /// A message longer than kMaxMessage (a 50 MB name echoed back) is cut, saying how much.
   void error(SourceLocation where, std::string message) {
+    if (message.size() > kMaxMessage) {
+      const std::size_t cut = message.size() - kMaxMessage;
+      message.resize(kMaxMessage);
+      message += "... (" + std::to_string(cut) + " more characters)";
+    }
     list_.push_back({std::move(where), std::move(message)});
   }
+  static constexpr std::size_t kMaxMessage = 2000;
   const std::vector<Diagnostic>& list() const { return list_; }
   std::vector<Diagnostic> take() { return std::move(list_); }
   std::size_t count() const { return list_.size(); }
