@@ -23,7 +23,7 @@ namespace avs::cli {
 
 namespace {
 
-std::atomic<bool> g_interrupted{false};
+std::atomic<bool> g_run_interrupted{false};
 
 std::string bool_word(bool b) {
   return b ? "true" : "false";
@@ -54,7 +54,7 @@ std::string progress_line(const runtime::Container& container,
 }  // namespace
 
 bool interrupted_by_signal() {
-  return g_interrupted.load();
+  return g_run_interrupted.load();
 }
 
 std::filesystem::path closed_loop_graph() {
@@ -120,7 +120,7 @@ ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progre
     int sig = 0;
     sigwait(&signals, &sig);
     if (!done.load()) {
-      g_interrupted = true;
+      g_run_interrupted = true;
       outcome.interrupted = true;
       container.stop();
     }

@@ -61,9 +61,9 @@ std::string describe_qos(const dds_qos_t* qos) {
   return s;
 }
 
-volatile std::sig_atomic_t g_interrupted = 0;
+volatile std::sig_atomic_t g_topic_interrupted = 0;
 void on_interrupt(int) {
-  g_interrupted = 1;
+  g_topic_interrupted = 1;
 }
 
 /// Ctrl-C and SIGTERM end a topic command cleanly (the wait for a publisher too). Installed
@@ -77,7 +77,7 @@ void handle_interrupts() {
 void sleep_unless_interrupted(std::chrono::milliseconds wait) {
   const auto end = Clock::now() + wait;
   while (Clock::now() < end) {
-    if (g_interrupted) throw runtime::Error("interrupted");
+    if (g_topic_interrupted) throw runtime::Error("interrupted");
     std::this_thread::sleep_for(
         std::min<Clock::duration>(std::chrono::milliseconds(50), end - Clock::now()));
   }
@@ -217,7 +217,7 @@ void add_common(Command* cmd, CommonOptions& o, bool needs_topic) {
 }
 
 bool should_stop(const CommonOptions& o, Clock::time_point start) {
-  if (g_interrupted) return true;
+  if (g_topic_interrupted) return true;
   return o.duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(o.duration_s);
 }
 
