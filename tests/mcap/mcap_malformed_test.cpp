@@ -87,6 +87,29 @@ TEST(McapMalformed, EveryTruncationIsAnErrorNamingTheOffset) {
   EXPECT_EQ(previous_count, expected.size());
 }
 
+TEST(McapMalformed, AFileKilledRightAfterOpenHasItsHeaderAndIsRepaired) {
+  // Issue 20 section 2: a recorder killed in its first half second left a 0-byte file that
+  // neither `info` nor `repair` accepted. The magic and the Header record reach the file at
+  // open(); what a kill leaves then (a copy of the file while the writer is still open) repairs
+  // into a valid empty bag.
+  const auto path = temp_path("just_opened.mcap");
+  const auto copy = temp_path("just_opened_copy.mcap");
+  const auto output = temp_path("just_opened_repaired.mcap");
+  Writer writer;
+  ASSERT_TRUE(writer.open(path).ok());
+  std::filesystem::copy_file(path, copy, std::filesystem::copy_options::overwrite_existing);
+  EXPECT_GT(std::filesystem::file_size(copy), 8u) << "the header is not in the file yet";
+  RepairReport report;
+  const Status repaired = repair_file(copy, output, report);
+  EXPECT_TRUE(repaired.ok()) << repaired.to_string();
+  EXPECT_EQ(report.messages_kept, 0u);
+  Reader reader;
+  ASSERT_TRUE(reader.open(output).ok());
+  EXPECT_TRUE(reader.read_summary().ok());
+  ASSERT_TRUE(writer.close().ok());
+  for (const auto& p : {path, copy, output}) std::filesystem::remove(p);
+}
+
 TEST(McapMalformed, TruncatedFileIsRepaired) {
   // Arrange: cut in the middle of a late chunk, like a recorder killed mid-write.
   const auto bytes = golden("golden_zstd.mcap");

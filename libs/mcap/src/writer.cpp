@@ -252,6 +252,9 @@ Status Writer::open(const std::filesystem::path& path, const WriterOptions& opti
   detail::put_string(head, options.library);
   detail::end_record(head, at);
   if (Status s = impl->file.write(head); !s.ok()) return s;
+  // The magic and the Header reach the kernel at once: a recorder killed before its first chunk
+  // leaves a file that `bag info` reads and `bag repair` completes, not an empty one.
+  if (Status s = impl->file.flush(); !s.ok()) return s;
   impl->current = impl->take_job();
   if (options.background_compression) {
     impl->worker = std::thread([raw = impl.get()] { raw->worker_loop(); });
