@@ -6,12 +6,14 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# What the demo needs (runtime, components, `avs`, report figures).
+# What the demo needs (runtime, components, `avs`, report figures; `avs view`: Boost.Beast
+# headers and nlohmann JSON).
 DEMO_PACKAGES=(
   build-essential cmake pkg-config
   cyclonedds-dev cyclonedds-tools
   libeigen3-dev libyaml-cpp-dev libcli11-dev libnanoflann-dev
   libmodbus-dev libzstd-dev liblz4-dev zlib1g-dev libpng-dev
+  libboost-dev nlohmann-json3-dev
   gnuplot-nox
 )
 # What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;
@@ -63,7 +65,7 @@ case "${1:-}" in
   test)
     install_missing "${DEMO_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
     # Debian's nodejs comes without npm (a separate package); a nodejs that bundles npm (and
-    # conflicts with Debian's) needs none. The MCAP reader check needs npm.
+    # conflicts with Debian's) needs none. The MCAP reader and `avs view` checks need npm.
     command -v npm >/dev/null || install_missing npm
     build "$BUILD_DIR"
     cd "$BUILD_DIR"

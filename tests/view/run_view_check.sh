@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# `avs view` acceptance check (issue 17): installs the Foxglove client packages (pinned by
+# js/package-lock.json) into the build tree, starts view_test_publisher and `avs view` on DDS
+# domain DOMAIN, and runs check_view.mjs against the server.
+# usage: run_view_check.sh SOURCE_DIR WORK_DIR AVS_BINARY PUBLISHER_BINARY DOMAIN
+set -euo pipefail
+src="$1/tests/view/js"
+work="$2"
+avs="$3"
+publisher="$4"
+domain="$5"
+bash "$1/tests/npm_ci.sh" "$src" "$work" check_view.mjs
+cd "$work"
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+}
+trap cleanup EXIT
+"$publisher" "$domain" > publisher.log 2>&1 &
+pids+=($!)
+"$avs" view --port 0 --domain "$domain" > view.log 2>&1 &
+pids+=($!)
+port=""
+for _ in $(seq 1 300); do
+  port=$(sed -n 's|.*ws://127.0.0.1:\([0-9]*\).*|\1|p' view.log | head -1)
+  [ -n "$port" ] && break
+  sleep 0.1
+done
+if [ -z "$port" ]; then
+  echo "FAILED: avs view did not print its address" >&2
+  cat view.log >&2
+  exit 1
+fi
+status=0
+node check_view.mjs "ws://127.0.0.1:$port" "$publisher" "$domain" || status=$?
+echo "--- avs view log:"
+cat view.log
+exit $status
