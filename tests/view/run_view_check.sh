@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # `avs view` acceptance check (issue 17): installs the Foxglove client packages (pinned by
 # js/package-lock.json) into the build tree, starts view_test_publisher and `avs view` on DDS
-# domain DOMAIN, and runs check_view.mjs against the server.
+# domain DOMAIN, with tests/view/tf_graph.yaml (tf_publisher) launched by `avs launch`, and
+# runs check_view.mjs against the server.
 # usage: run_view_check.sh SOURCE_DIR WORK_DIR AVS_BINARY PUBLISHER_BINARY DOMAIN
 set -euo pipefail
 src="$1/tests/view/js"
@@ -18,6 +19,8 @@ cleanup() {
 }
 trap cleanup EXIT
 "$publisher" "$domain" > publisher.log 2>&1 &
+pids+=($!)
+AVS_DOMAIN_ID="$domain" "$avs" launch "$1/tests/view/tf_graph.yaml" > graph.log 2>&1 &
 pids+=($!)
 "$avs" view --port 0 --domain "$domain" > view.log 2>&1 &
 pids+=($!)
@@ -36,4 +39,6 @@ status=0
 node check_view.mjs "ws://127.0.0.1:$port" "$publisher" "$domain" || status=$?
 echo "--- avs view log:"
 cat view.log
+echo "--- graph log:"
+cat graph.log
 exit $status

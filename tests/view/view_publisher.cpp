@@ -4,6 +4,7 @@
 //   pose:  frame "camera_optical_frame", position (i * 0.001, -i * 0.5, 1.25), orientation
 //          (0, 0, 0.6, 0.8)
 //   image: frame "camera_optical_frame", pixel (x, y) = (i % 1000) + x * 0.5 + y * 0.25
+//   /head/joint_states: joints "pan", "tilt" at positions (i * 0.001, -(i * 0.0005)) rad
 // With --ephemeral it publishes std_msgs/String on /view_test/ephemeral instead, so that the
 // test can make a channel appear and disappear. Runs until SIGTERM/SIGINT.
 // usage: view_test_publisher DOMAIN [--ephemeral]
@@ -64,6 +65,7 @@ int main(int argc, char** argv) {
   }
   Output<msgs::geometry_msgs::PoseStamped> pose_out(participant, "rt/object/pose");
   Output<msgs::sensor_msgs::Image> image_out(participant, "rt/depth/image");
+  Output<msgs::sensor_msgs::JointState> joints_out(participant, "rt/head/joint_states");
   constexpr std::uint32_t kWidth = 160, kHeight = 120;
   auto next = std::chrono::steady_clock::now();
   for (std::uint32_t i = 0; !g_stop; ++i) {
@@ -93,6 +95,16 @@ int main(int argc, char** argv) {
       }
     }
     image_out.writer.write(image.get());
+
+    auto joints = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    joints->header.stamp.sec = static_cast<std::int32_t>(100 + i);
+    runtime::resize_sequence(joints->name, 2);
+    runtime::set_string(joints->name._buffer[0], "pan");
+    runtime::set_string(joints->name._buffer[1], "tilt");
+    runtime::resize_sequence(joints->position, 2);
+    joints->position._buffer[0] = i * 0.001;
+    joints->position._buffer[1] = -(i * 0.0005);
+    joints_out.writer.write(joints.get());
     next += std::chrono::milliseconds(10);
     std::this_thread::sleep_until(next);
   }

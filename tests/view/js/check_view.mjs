@@ -5,6 +5,9 @@
 // the message index). Then: a client that reads nothing gets its drop counter raised on
 // /diagnostics while the others keep receiving; bad requests are rejected with a status;
 // unsubscribe stops a channel; a channel appears and disappears with its publisher.
+// /tf and /tf_static come from tf_publisher (tests/view/tf_graph.yaml): the head chain at the
+// published joint angles, the object at the published pose, the same frame names as the
+// stamped messages.
 // Every wait is for a condition, with a generous timeout; nothing depends on speed.
 // usage: node check_view.mjs ws://127.0.0.1:PORT PUBLISHER_BINARY DOMAIN
 import { spawn } from "node:child_process";
@@ -154,12 +157,15 @@ async function main() {
   const a = new Viewer("A");
   await waitFor("serverInfo", () => a.serverInfo);
   check(a.serverInfo.capabilities.length === 0, "serverInfo capabilities are empty");
-  await waitFor("channels /object/pose, /depth/image, /diagnostics", () =>
-    a.channel("/object/pose") && a.channel("/depth/image") && a.channel("/diagnostics"));
+  await waitFor("channels /object/pose, /depth/image, /diagnostics, /tf, /tf_static", () =>
+    a.channel("/object/pose") && a.channel("/depth/image") && a.channel("/diagnostics") &&
+    a.channel("/tf") && a.channel("/tf_static"));
   const expectedTypes = {
     "/object/pose": "geometry_msgs/msg/PoseStamped",
     "/depth/image": "sensor_msgs/msg/Image",
     "/diagnostics": "diagnostic_msgs/msg/DiagnosticArray",
+    "/tf": "tf2_msgs/msg/TFMessage",
+    "/tf_static": "tf2_msgs/msg/TFMessage",
   };
   for (const [topic, type] of Object.entries(expectedTypes)) {
     const c = a.channel(topic);
@@ -177,6 +183,57 @@ async function main() {
   let imageOk = a.received.get("/depth/image").every(checkImage);
   check(poseOk && imageOk, "decoded poses and images equal what was published");
   console.log(`decoded ${a.count("/object/pose")} poses and ${a.count("/depth/image")} images: ok`);
+
+  // 2b. The frames: /tf_static (latched) and /tf, checked against the published joint
+  // angles and poses; the stamped messages' frame_id is the tree's camera frame.
+  a.subscribe("/tf_static");
+  a.subscribe("/tf");
+  const transforms = (topic) => (a.received.get(topic) ?? []).flatMap((m) => m.transforms);
+  const find = (topic, parent, child) =>
+    transforms(topic).filter((t) => t.header.frame_id === parent && t.child_frame_id === child);
+  await waitFor("/tf_static mount and projector", () =>
+    find("/tf_static", "tilt_link", "camera_optical_frame").length > 0 &&
+    find("/tf_static", "camera_optical_frame", "projector_optical_frame").length > 0);
+  await waitFor("/tf head chain and object", () =>
+    find("/tf", "world", "pan_link").length >= 5 && find("/tf", "pan_link", "tilt_link").length >= 5 &&
+    find("/tf", "camera_optical_frame", "object").length >= 5);
+  const near = (a, b) => Math.abs(a - b) < 1e-9;
+  const mount = find("/tf_static", "tilt_link", "camera_optical_frame")[0].transform;
+  // HeadConfig default: camera 40 mm ahead of the tilt axis; optical axes x right, y down,
+  // z forward in a link frame X forward, Y left, Z up: quaternion (-0.5, 0.5, -0.5, 0.5).
+  check(near(mount.translation.x, 0.04) && near(mount.translation.y, 0) && near(mount.translation.z, 0),
+    `camera mount translation ${JSON.stringify(mount.translation)}`);
+  const q = mount.rotation;
+  const sign = Math.sign(q.w);
+  check(near(sign * q.x, -0.5) && near(sign * q.y, 0.5) && near(sign * q.z, -0.5) && near(sign * q.w, 0.5),
+    `camera mount rotation ${JSON.stringify(q)}`);
+  for (const t of find("/tf", "world", "pan_link")) {
+    const i = t.header.stamp.sec - 100;
+    const r = t.transform.rotation; // about -Z by q1 = i * 0.001
+    const s = Math.sign(r.w) || 1;
+    check(near(s * r.x, 0) && near(s * r.y, 0) && near(s * r.z, -Math.sin(i * 0.001 / 2)) &&
+      near(s * r.w, Math.cos(i * 0.001 / 2)), `world->pan_link ${i}: ${JSON.stringify(r)}`);
+  }
+  for (const t of find("/tf", "pan_link", "tilt_link")) {
+    const i = t.header.stamp.sec - 100;
+    const r = t.transform.rotation; // about +Y by q2 = -(i * 0.0005)
+    const s = Math.sign(r.w) || 1;
+    check(near(s * r.x, 0) && near(s * r.y, Math.sin(-(i * 0.0005) / 2)) && near(s * r.z, 0) &&
+      near(s * r.w, Math.cos(-(i * 0.0005) / 2)), `pan_link->tilt_link ${i}: ${JSON.stringify(r)}`);
+  }
+  for (const t of find("/tf", "camera_optical_frame", "object")) {
+    const i = t.header.stamp.sec - 100;
+    const p = t.transform.translation;
+    const r = t.transform.rotation;
+    const s = Math.sign(r.w) || 1;
+    check(p.x === i * 0.001 && p.y === -(i * 0.5) && p.z === 1.25, `object ${i} at ${JSON.stringify(p)}`);
+    check(near(s * r.z, 0.6) && near(s * r.w, 0.8), `object ${i} rotation ${JSON.stringify(r)}`);
+  }
+  const poseFrame = a.received.get("/object/pose")[0].header.frame_id;
+  const imageFrame = a.received.get("/depth/image")[0].header.frame_id;
+  check(poseFrame === "camera_optical_frame" && imageFrame === poseFrame,
+    `stamped messages' frame ${poseFrame}, ${imageFrame} is the tree's camera_optical_frame`);
+  console.log(`/tf: ${transforms("/tf").length} transforms, /tf_static: ${transforms("/tf_static").length}: ok`);
 
   // 3. Bad requests are rejected with a reason and change nothing.
   a.ws.send("this is not JSON");
