@@ -18,10 +18,11 @@ DEMO_PACKAGES=(
 )
 # What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;
 # the MCAP fuzzer: clang; the independent MCAP reader: Node.js; the deployment tests: network
-# namespaces, openssl for DDS Security documents, iceoryx's RouDi for shared memory).
+# namespaces, openssl for DDS Security documents, iceoryx's RouDi for shared memory; the
+# `avs view` page test: Debian's chromium, driven headless).
 TEST_PACKAGES=(
   libopencv-dev libpcl-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev chromium
   clang libclang-rt-14-dev nodejs
   iproute2 openssl python3 iceoryx
 )

@@ -8,7 +8,7 @@ set -euo pipefail
 src="$1/tests/mcap/js"
 work="$2"
 fixture="$3"
-bash "$1/tests/npm_ci.sh" "$src" "$work" check_mcap.mjs
+bash "$1/cmake/npm_ci.sh" "$src" "$work" check_mcap.mjs
 cd "$work"
 "$fixture" "$work"
 node check_mcap.mjs expected.json avs_none.mcap avs_lz4.mcap avs_zstd.mcap

@@ -2,15 +2,17 @@
 # `avs view` acceptance check (issue 17): installs the Foxglove client packages (pinned by
 # js/package-lock.json) into the build tree, starts view_test_publisher and `avs view` on DDS
 # domain DOMAIN, with tests/view/tf_graph.yaml (tf_publisher) launched by `avs launch`, and
-# runs check_view.mjs against the server.
-# usage: run_view_check.sh SOURCE_DIR WORK_DIR AVS_BINARY PUBLISHER_BINARY DOMAIN
+# runs CHECK against the server: client (check_view.mjs, the Foxglove client) or page
+# (check_page.mjs, the page in headless Chromium; its screenshot is WORK_DIR/view_page.png).
+# usage: run_view_check.sh SOURCE_DIR WORK_DIR AVS_BINARY PUBLISHER_BINARY DOMAIN CHECK
 set -euo pipefail
 src="$1/tests/view/js"
 work="$2"
 avs="$3"
 publisher="$4"
 domain="$5"
-bash "$1/tests/npm_ci.sh" "$src" "$work" check_view.mjs
+check="$6"
+bash "$1/cmake/npm_ci.sh" "$src" "$work" check_view.mjs check_page.mjs
 cd "$work"
 pids=()
 cleanup() {
@@ -36,7 +38,15 @@ if [ -z "$port" ]; then
   exit 1
 fi
 status=0
-node check_view.mjs "ws://127.0.0.1:$port" "$publisher" "$domain" || status=$?
+if [ "$check" = page ]; then
+  if [ ! -x "${AVS_CHROMIUM:-/usr/bin/chromium}" ]; then
+    echo "FAILED: no chromium (bash tools/run.sh test installs Debian's chromium)" >&2
+    exit 1
+  fi
+  node check_page.mjs "http://127.0.0.1:$port/" "$work/view_page.png" || status=$?
+else
+  node check_view.mjs "ws://127.0.0.1:$port" "$publisher" "$domain" || status=$?
+fi
 echo "--- avs view log:"
 cat view.log
 echo "--- graph log:"

@@ -25,6 +25,7 @@ struct ViewArgs {
   double image_max_rate_hz = 0;
   unsigned long queue_depth = 8;
   double duration_s = 0;
+  std::string web_root = view::built_page_dir().string();
 };
 
 void run_view(const ViewArgs& a) {
@@ -36,11 +37,19 @@ void run_view(const ViewArgs& a) {
   o.server.port = static_cast<std::uint16_t>(a.port);
   o.server.client_defaults.max_rate_hz = a.image_max_rate_hz;
   o.server.limits.queue_depth = a.queue_depth;
+  o.server.web_root = a.web_root;
   view::View v(o);
   v.start();
   std::printf("avs view: Foxglove WebSocket server on ws://%s:%u (domain %d, subprotocol %s)\n",
               a.address.c_str(), static_cast<unsigned>(v.port()), a.domain,
               std::string(view::kSubprotocol).c_str());
+  if (a.web_root.empty()) {
+    std::printf("avs view: NO PAGE at http://%s:%u/: this build had no npm to bundle it\n",
+                a.address.c_str(), static_cast<unsigned>(v.port()));
+  } else {
+    std::printf("avs view: page at http://%s:%u/ (from %s)\n", a.address.c_str(),
+                static_cast<unsigned>(v.port()), a.web_root.c_str());
+  }
   std::fflush(stdout);
   struct sigaction sa {};
   sa.sa_handler = on_signal;
@@ -79,11 +88,14 @@ void add_view_command(Command& app) {
                   "messages waiting per client and subscription; the oldest is dropped (and "
                   "counted on /diagnostics) when a slow client lets it fill")
       ->capture_default_str();
+  cmd->add_option("--web-root", a.web_root,
+                  "folder of the page served at / (default: the one this build bundled)")
+      ->capture_default_str();
   cmd->add_option("--duration", a.duration_s, "stop after this many seconds (0: until Ctrl-C)");
   cmd->footer(
       "Every DDS topic with a publisher and a type this build knows is advertised with its "
       "ros2msg schema and encoding cdr; messages are forwarded as received from DDS. "
-      "http://HOST:PORT/ answers with a notice: the built-in page is NOT IMPLEMENTED yet. "
+      "http://HOST:PORT/ serves the live page (depth map, pose, pan/tilt, diagnostics). "
       "See docs/view.md.");
   cmd->callback([] { run_view(a); });
 }

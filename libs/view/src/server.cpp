@@ -4,13 +4,17 @@
 #include "avs/view/server.hpp"
 
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <map>
 #include <mutex>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -67,11 +71,38 @@ bool offers_subprotocol(std::string_view list, std::string_view wanted) {
   return false;
 }
 
-constexpr std::string_view kNoPage =
-    "<!doctype html><html><head><meta charset=\"utf-8\"><title>avs view</title></head><body>"
-    "<h1>avs view</h1><p><b>NOT IMPLEMENTED YET:</b> the built-in live page (issue 17, "
-    "section 3) is not part of this build. The Foxglove WebSocket server runs on this port: "
-    "open Foxglove and connect to <code>ws://HOST:PORT</code> (docs/view.md).</p></body></html>";
+std::string no_page(const std::string& why) {
+  return "<!doctype html><html><head><meta charset=\"utf-8\"><title>avs view</title></head>"
+         "<body><h1>avs view</h1><p><b>NO PAGE:</b> " +
+         why +
+         "</p><p>The Foxglove WebSocket server runs on this port: open Foxglove and connect to "
+         "<code>ws://HOST:PORT</code> (docs/view.md).</p></body></html>";
+}
+
+/// Content type by file name ending; nullptr for files the server does not hand out.
+const char* content_type(const std::string& name) {
+  const auto ends = [&](std::string_view end) {
+    return name.size() >= end.size() &&
+           name.compare(name.size() - end.size(), end.size(), end) == 0;
+  };
+  if (ends(".html")) return "text/html; charset=utf-8";
+  if (ends(".js")) return "text/javascript; charset=utf-8";
+  if (ends(".css")) return "text/css; charset=utf-8";
+  if (ends(".png")) return "image/png";
+  if (ends(".map") || ends(".json")) return "application/json";
+  return nullptr;
+}
+
+/// A file name in the page folder: letters, digits, '.', '_', '-', not starting with '.'.
+bool plain_file_name(std::string_view name) {
+  if (name.empty() || name.front() == '.') return false;
+  for (const char c : name) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-') {
+      return false;
+    }
+  }
+  return true;
+}
 
 }  // namespace
 
@@ -300,12 +331,34 @@ class HttpSession : public std::enable_shared_from_this<HttpSession> {
     }
     if (request_.method() != http::verb::get && request_.method() != http::verb::head) {
       respond(http::status::method_not_allowed, "text/plain", "avs view: GET only\n");
-    } else if (request_.target() == "/" || request_.target() == "/index.html") {
-      respond(http::status::ok, "text/html; charset=utf-8", std::string(kNoPage));
     } else {
-      respond(http::status::not_found, "text/plain",
-              "avs view: no such page: " + std::string(request_.target()) + "\n");
+      serve_file(std::string(request_.target()));
     }
+  }
+
+  void serve_file(std::string target) {
+    target = target.substr(0, target.find('?'));
+    const std::string name = target == "/" ? "index.html" : target.substr(1);
+    const std::filesystem::path& root = server_.options.web_root;
+    const char* type = content_type(name);
+    if (root.empty() || !std::filesystem::is_regular_file(root / "index.html")) {
+      if (name == "index.html") {
+        respond(http::status::ok, "text/html; charset=utf-8",
+                no_page(root.empty() ? "this build has no page (it needs node and npm at build "
+                                       "time: bash tools/run.sh test installs them)"
+                                     : "no index.html in " + root.string()));
+        return;
+      }
+    } else if (plain_file_name(name) && type != nullptr) {
+      std::ifstream in(root / name, std::ios::binary);
+      if (in) {
+        std::ostringstream body;
+        body << in.rdbuf();
+        respond(http::status::ok, type, body.str());
+        return;
+      }
+    }
+    respond(http::status::not_found, "text/plain", "avs view: no such page: " + target + "\n");
   }
 
   void respond(http::status status, const char* type, std::string body) {

@@ -45,6 +45,14 @@ struct TopicState {
 
 }  // namespace
 
+std::filesystem::path built_page_dir() {
+#ifdef AVS_VIEW_PAGE_DIR
+  return AVS_VIEW_PAGE_DIR;
+#else
+  return {};
+#endif
+}
+
 bool is_image_type(const std::string& ros_type) {
   return ros_type == "sensor_msgs/msg/Image" || ros_type == "sensor_msgs/msg/CompressedImage" ||
          ros_type == "sensor_msgs/msg/PointCloud2" || ros_type == "avs_msgs/msg/PatternFrame";

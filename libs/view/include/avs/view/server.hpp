@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -26,6 +27,9 @@ struct ServerOptions {
   /// Messages handed to publish() that the network thread has not taken yet; beyond this
   /// they are dropped at once and counted (overload_dropped).
   std::size_t max_pending_messages = 4096;
+  /// Folder of the page served at `/` (index.html and the files beside it; no subfolders).
+  /// Empty or without index.html: `/` answers with a notice that the page is not available.
+  std::filesystem::path web_root;
 };
 
 struct ClientStats {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <memory>
 
 #include "avs/view/server.hpp"
@@ -37,6 +38,9 @@ class View {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The page bundled by this build (libs/view/page), or "" when the build had no npm.
+std::filesystem::path built_page_dir();
 
 /// True for the types a client's max_rate_hz thins (images, point clouds, pattern frames).
 bool is_image_type(const std::string& ros_type);
