@@ -77,6 +77,19 @@ int free_tcp_port() {
   return ntohs(addr.sin_port);
 }
 
+int choose_closed_loop_domain(const ClosedLoopRun& run, std::ostream& progress) {
+  // The run is private unless asked otherwise: samples of another system on the same DDS
+  // domain (a second demo, a test) would reach these components and break the lockstep
+  // run's determinism. AVS_DOMAIN_ID=N shares the run with `avs topic` & co. on domain N.
+  if (const char* domain = std::getenv("AVS_DOMAIN_ID"); domain == nullptr || *domain == 0) {
+    const std::string id = std::to_string(200 + getpid() % 32);
+    setenv("AVS_DOMAIN_ID", id.c_str(), 1);
+    progress << "[" << run.scenario << "] DDS domain " << id
+             << " (private to this run; set AVS_DOMAIN_ID to watch it with avs topic)\n";
+  }
+  return std::atoi(std::getenv("AVS_DOMAIN_ID"));
+}
+
 ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progress) {
   ClosedLoopOutcome outcome;
   std::filesystem::create_directories(run.dir);
@@ -95,15 +108,7 @@ ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progre
   for (const auto& [name, value] : run.extra_args) words.push_back(name + ":=" + value);
   auto graph = load_or_report(closed_loop_graph().string(), words);
   if (!graph) return outcome;
-  // The run is private unless asked otherwise: samples of another system on the same DDS
-  // domain (a second demo, a test) would reach these components and break the lockstep
-  // run's determinism. AVS_DOMAIN_ID=N shares the run with `avs topic` & co. on domain N.
-  if (const char* domain = std::getenv("AVS_DOMAIN_ID"); domain == nullptr || *domain == 0) {
-    const std::string id = std::to_string(200 + getpid() % 32);
-    setenv("AVS_DOMAIN_ID", id.c_str(), 1);
-    progress << "[" << run.scenario << "] DDS domain " << id
-             << " (private to this run; set AVS_DOMAIN_ID to watch it with avs topic)\n";
-  }
+  choose_closed_loop_domain(run, progress);
   const graph::ContainerSpec& spec = graph->containers.front();
 
   // Ctrl-C / SIGTERM go to a waiter thread that stops the container: the components are

@@ -3,13 +3,15 @@
 // page has drawn depth frames and poses, checks that the depth canvas is not blank (most
 // pixels coloured, both ends of the colour map present) and that the pose readout changes,
 // and saves a screenshot. Waits are for conditions, with generous timeouts.
-// usage: node check_page.mjs http://127.0.0.1:PORT/ SCREENSHOT.png
+// usage: node check_page.mjs http://127.0.0.1:PORT/ SCREENSHOT.png [JOINT_STATES]
+// (JOINT_STATES: joint states the page must have drawn before the screenshot, default 200;
+// docs/img/view_page.png was taken during `avs demo --view` with 4000.)
 import { createRequire } from "node:module";
 
 const require = createRequire(import.meta.url);
 const puppeteer = require("puppeteer-core");
 
-const [url, screenshot] = process.argv.slice(2);
+const [url, screenshot, jointStates = "200"] = process.argv.slice(2);
 const TIMEOUT_MS = 60000;
 const chromium = process.env.AVS_CHROMIUM ?? "/usr/bin/chromium";
 
@@ -17,9 +19,10 @@ async function main() {
   const browser = await puppeteer.launch({
     executablePath: chromium,
     headless: true,
-    // Root in a container: no sandbox; no GPU on the test machines.
-    args: ["--no-sandbox", "--disable-gpu", "--window-size=1280,900"],
+    // Root in a container: no sandbox; no GPU on the test machines; a small /dev/shm.
+    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1280,900"],
     defaultViewport: { width: 1280, height: 900 },
+    protocolTimeout: 20 * TIMEOUT_MS,
   });
   let failures = 0;
   const check = (ok, what) => {
@@ -64,8 +67,9 @@ async function main() {
     const second = await page.$eval("#pose-readout", (e) => e.textContent);
     console.log(`pose readout changed:\n${first}\n->\n${second}`);
     check(second.includes("camera_optical_frame"), "the pose readout names its frame");
-    // Let the 10 s plots fill a little before the picture (condition: 2 s of joint stamps).
-    await page.waitForFunction(() => window.avsView.jointCount >= 200, { timeout: TIMEOUT_MS });
+    // Let the plots fill a little before the picture.
+    await page.waitForFunction((n) => window.avsView.jointCount >= n, { timeout: 10 * TIMEOUT_MS },
+      Number(jointStates));
     await page.screenshot({ path: screenshot });
     console.log(`screenshot: ${screenshot}`);
   } finally {

@@ -288,7 +288,9 @@ async function main() {
   // 6. Unsubscribe stops the channel (after what was already on its way).
   a.unsubscribe(imageSub);
   let mark = a.count("/object/pose");
-  await waitFor("20 poses after unsubscribing", () => a.count("/object/pose") >= mark + 20);
+  // 50 poses (0.5 s of publishing) for the request to be handled and what was sent before it
+  // to arrive; from then on no image may come.
+  await waitFor("50 poses after unsubscribing", () => a.count("/object/pose") >= mark + 50);
   const imagesAfter = a.count("/depth/image");
   mark = a.count("/object/pose");
   await waitFor("20 more poses", () => a.count("/object/pose") >= mark + 20);
