@@ -6,20 +6,23 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# What the demo needs (runtime, components, `avs`, report figures).
+# What the demo needs (runtime, components, `avs`, report figures; `avs view`: Boost.Beast
+# headers and nlohmann JSON).
 DEMO_PACKAGES=(
   build-essential cmake pkg-config
   cyclonedds-dev cyclonedds-tools
   libeigen3-dev libyaml-cpp-dev libcli11-dev libnanoflann-dev
   libmodbus-dev libzstd-dev liblz4-dev zlib1g-dev libpng-dev
+  libboost-dev nlohmann-json3-dev
   gnuplot-nox
 )
 # What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;
 # the MCAP fuzzer: clang; the independent MCAP reader: Node.js; the deployment tests: network
-# namespaces, openssl for DDS Security documents, iceoryx's RouDi for shared memory).
+# namespaces, openssl for DDS Security documents, iceoryx's RouDi for shared memory; the
+# `avs view` page test: Debian's chromium, driven headless).
 TEST_PACKAGES=(
   libopencv-dev libpcl-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev chromium
   clang libclang-rt-14-dev nodejs
   iproute2 openssl python3 iceoryx
 )
@@ -63,7 +66,7 @@ case "${1:-}" in
   test)
     install_missing "${DEMO_PACKAGES[@]}" "${TEST_PACKAGES[@]}"
     # Debian's nodejs comes without npm (a separate package); a nodejs that bundles npm (and
-    # conflicts with Debian's) needs none. The MCAP reader check needs npm.
+    # conflicts with Debian's) needs none. The MCAP reader and `avs view` checks need npm.
     command -v npm >/dev/null || install_missing npm
     build "$BUILD_DIR"
     cd "$BUILD_DIR"

@@ -27,6 +27,9 @@ struct TopicEntry {
   const msg::TypeEntry* type = nullptr;
   std::unique_ptr<dds::Topic> topic;
   std::unique_ptr<dds::Writer> writer;
+  /// The writer keeps its last samples for readers that match later (transient local):
+  /// they must reach the DDS writer even when no remote reader is matched yet.
+  bool latched = false;
   std::unique_ptr<dds::Reader> reader;
   dds::Entity read_condition;
   std::vector<LocalSubscription> subscriptions;  // fixed once the container runs
@@ -207,8 +210,8 @@ class LocalPublisher final : public PublisherCore {
     for (const auto& sub : topic_.subscriptions) {
       scheduler_.post(sub.lane, [deliver = sub.deliver, sample] { deliver(sample); });
     }
-    // Serialise only when a reader in another participant wants it.
-    if (topic_.writer->matched_readers() > 0) topic_.writer->write(sample.get());
+    // Serialise only when a reader in another participant wants it, now or (latched) later.
+    if (topic_.latched || topic_.writer->matched_readers() > 0) topic_.writer->write(sample.get());
   }
   const std::string& topic() const override { return topic_.dds_name; }
 
@@ -224,8 +227,10 @@ std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view po
   if (container_.running) throw Error("publishers must be created in the constructor");
   auto [dds_name, qos] = resolve(port, type, true);
   TopicEntry& topic = container_.topic(dds_name, type, qos);
-  if (!topic.writer)
+  if (!topic.writer) {
     topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
+    topic.latched = qos.durability == Durability::transient_local;
+  }
   return std::make_shared<LocalPublisher>(*container_.scheduler, topic);
 }
 

@@ -2,8 +2,8 @@
 // /head/joint_states at 1 kHz (the pan swinging) and, at 500 Hz, z-buffer depth images
 // (matching's render_depth, 32FC1, NaN where empty) of the shipped ken moving across the room,
 // seen through the head's TRUE angles. A recorder checks that a pose comes out for every depth
-// image, stamped like it, in the camera frame ("camera") and in the world frame ("world"), both
-// against the source's ground truth, plus /object/match and /timing.
+// image, stamped like it, in the camera frame ("camera_optical_frame") and in the world frame
+// ("world"), both against the source's ground truth, plus /object/match and /timing.
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -257,7 +257,7 @@ TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
     const double t = static_cast<double>(depth[i]) * 1e-9;
     EXPECT_EQ(rec.camera[i].stamp_ns, depth[i]);
     EXPECT_EQ(rec.world[i].stamp_ns, depth[i]);
-    EXPECT_EQ(rec.camera[i].frame, "camera");
+    EXPECT_EQ(rec.camera[i].frame, "camera_optical_frame");
     EXPECT_EQ(rec.world[i].frame, "world");
     if (i > 0) {
       EXPECT_EQ(depth[i] - depth[i - 1], 2000000) << "500 Hz";

@@ -24,6 +24,25 @@ TEST(Head, ZeroAnglesLookAlongWorldXWithCameraOffsetA) {
   EXPECT_TRUE(T.translation().isApprox(Eigen::Vector3d(0.05, 0, 0)));
 }
 
+TEST(Head, LinksOfTfComposeToTheCameraPose) {
+  // /tf's world -> pan_link -> tilt_link -> camera_optical_frame (components/frames): the pan
+  // link turns about the world's Z only, the tilt link about pan_link's Y only, the mount is
+  // fixed, and together they are T_world_camera.
+  HeadConfig head;
+  head.p_world_pan_m = Eigen::Vector3d(0.1, -0.2, 0.3);
+  head.p_pan_tilt_m = Eigen::Vector3d(0.01, 0.02, 0.05);
+  const double pan = 0.3, tilt = -0.2;
+  const Eigen::Isometry3d T_world_pan = geometry::T_world_pan(head, pan);
+  const Eigen::Isometry3d T_pan_tilt = geometry::T_pan_tilt(head, tilt);
+  EXPECT_TRUE((T_world_pan.linear() * Eigen::Vector3d::UnitZ()).isApprox(Eigen::Vector3d::UnitZ()));
+  EXPECT_TRUE((T_pan_tilt.linear() * Eigen::Vector3d::UnitY()).isApprox(Eigen::Vector3d::UnitY()));
+  EXPECT_TRUE(T_world_pan.translation().isApprox(head.p_world_pan_m));
+  EXPECT_TRUE(T_pan_tilt.translation().isApprox(head.p_pan_tilt_m));
+  const Eigen::Isometry3d composed = T_world_pan * T_pan_tilt * geometry::T_tilt_camera(head);
+  EXPECT_TRUE(composed.isApprox(T_world_camera(head, pan, tilt)));
+  EXPECT_TRUE(geometry::T_tilt_camera(head).translation().isApprox(head.p_tilt_camera_m));
+}
+
 TEST(Head, PositivePanTurnsRightPositiveTiltLooksDownAndTheOffsetSwingsWithThem) {
   // Servo convention (docs/servo.md section 1): positive pan turns the optical axis toward
   // image +x (world -Y at home), positive tilt toward image +y (down).

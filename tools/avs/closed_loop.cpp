@@ -78,6 +78,21 @@ int free_tcp_port() {
   return ntohs(addr.sin_port);
 }
 
+int choose_closed_loop_domain(const ClosedLoopRun& run, std::ostream& progress) {
+  // The run is private unless asked otherwise: samples of another system on the same DDS
+  // domain (a second demo, a test) would reach these components and break the lockstep
+  // run's determinism. AVS_DOMAIN_ID=N shares the run with `avs topic` & co. on domain N.
+  if (const auto domain = environment_domain()) return *domain;
+  const int domain = 200 + getpid() % 32;
+  static bool said = false;
+  if (!said) {
+    progress << "[" << run.scenario << "] DDS domain " << domain
+             << " (private to this run; set AVS_DOMAIN_ID to watch it with avs topic)\n";
+    said = true;
+  }
+  return domain;
+}
+
 ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progress) {
   ClosedLoopOutcome outcome;
   std::filesystem::create_directories(run.dir);
@@ -96,14 +111,7 @@ ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progre
   for (const auto& [name, value] : run.extra_args) words.push_back(name + ":=" + value);
   auto graph = load_or_report(closed_loop_graph().string(), words);
   if (!graph) return outcome;
-  // The run is private unless asked otherwise: samples of another system on the same DDS
-  // domain (a second demo, a test) would reach these components and break the lockstep
-  // run's determinism. AVS_DOMAIN_ID=N shares the run with `avs topic` & co. on domain N.
-  if (!environment_domain()) {
-    graph->domain_id = 200 + getpid() % 32;
-    progress << "[" << run.scenario << "] DDS domain " << graph->domain_id
-             << " (private to this run; set AVS_DOMAIN_ID to watch it with avs topic)\n";
-  }
+  graph->domain_id = choose_closed_loop_domain(run, progress);
   const graph::ContainerSpec& spec = graph->containers.front();
 
   // Ctrl-C / SIGTERM go to a waiter thread that stops the container: the components are

@@ -38,6 +38,11 @@ std::filesystem::path closed_loop_graph();
 /// A TCP port on 127.0.0.1 that nobody listens on right now (for the simulated amplifiers).
 int free_tcp_port();
 
+/// The DDS domain of closed-loop runs in this process: $AVS_DOMAIN_ID, or (unset) a private
+/// one in 200-231, the same for every call. Called by run_closed_loop; call it before to
+/// start something on the same domain (`avs demo --view`).
+int choose_closed_loop_domain(const ClosedLoopRun& run, std::ostream& progress);
+
 /// Runs the graph into run.dir, printing progress to `progress`. SIGINT/SIGTERM stop the run
 /// early (what was recorded stays usable: a partial report); handled for the call only.
 ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progress);

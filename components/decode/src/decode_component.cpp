@@ -15,6 +15,7 @@
 
 #include "avs/decode/calibration_yaml.hpp"
 #include "avs/decode/rolling_decoder.hpp"
+#include "avs/geometry/frames.hpp"
 #include "avs/msg/camera_info.hpp"
 #include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
@@ -91,7 +92,8 @@ class DecodeComponent final : public runtime::Component {
                                {"rolling", "full_cycle"}),
              ParamSpec::boolean("publish_points", false,
                                 "also publish /depth/points (organised XYZ float32)"),
-             ParamSpec::string("frame_id", "camera", "header.frame_id of depth and points")}),
+             ParamSpec::string("frame_id", geometry::frame::kCameraOptical,
+                               "header.frame_id of depth and points (the /tf frame)")}),
         .publishes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
                       runtime::port<msgs::sensor_msgs::PointCloud2>("points", "/depth/points",
                                                                     points_qos),

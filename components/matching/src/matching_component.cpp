@@ -12,6 +12,7 @@
 #include <optional>
 #include <utility>
 
+#include "avs/geometry/frames.hpp"
 #include "avs/geometry/head_kinematics.hpp"
 #include "avs/matching/joint_history.hpp"
 #include "avs/matching/pipeline.hpp"
@@ -304,10 +305,10 @@ class MatchingComponent final : public runtime::Component {
     if (out.has_pose) {
       ++poses_;
       const Eigen::Isometry3d T_camera_model = out.T_camera_model.cast<double>();
-      publish_pose(pose_, image.header.stamp, "camera", T_camera_model);
+      publish_pose(pose_, image.header.stamp, geometry::frame::kCameraOptical, T_camera_model);
       if (const auto q = joints_.at(stamp_s, max_extrapolation_s_)) {
         T_world_model = geometry::T_world_camera(head_, q->pan_rad, q->tilt_rad) * T_camera_model;
-        publish_pose(pose_world_, image.header.stamp, "world", *T_world_model);
+        publish_pose(pose_world_, image.header.stamp, geometry::frame::kWorld, *T_world_model);
         ++world_poses_;
       } else if (!warned_no_joints_) {
         log().warn("no /head/joint_states around t = ", stamp_s,
@@ -353,7 +354,7 @@ class MatchingComponent final : public runtime::Component {
   void publish_match(const msgs::sensor_msgs::Image& image, const PipelineOutput& out) {
     auto msg = runtime::make_sample<msgs::avs_msgs::MatchResult>();
     msg->header.stamp = image.header.stamp;
-    runtime::set_string(msg->header.frame_id, "camera");
+    runtime::set_string(msg->header.frame_id, geometry::frame::kCameraOptical);
     msg::to_pose(out.T_camera_model.cast<double>(), msg->pose);
     msg->rmse_m = out.track.icp.rmse_m;
     msg->inliers = static_cast<std::uint32_t>(out.track.icp.inliers);
@@ -377,7 +378,7 @@ class MatchingComponent final : public runtime::Component {
     const Points& points = pipeline_->scene_points();
     auto msg = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
     msg->header.stamp = image.header.stamp;
-    runtime::set_string(msg->header.frame_id, "camera");
+    runtime::set_string(msg->header.frame_id, geometry::frame::kCameraOptical);
     msg::write_xyz_cloud(points, *msg);
     scene_points_.publish(std::move(msg));
   }

@@ -17,6 +17,7 @@
 
 #include "avs/decode/calibration_yaml.hpp"
 #include "avs/geometry/builtin_models.hpp"
+#include "avs/geometry/frames.hpp"
 #include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/sim/scene_yaml.hpp"
@@ -351,7 +352,7 @@ class SimScene final : public runtime::Component {
     publish_truth(frame, now);
     auto timing = runtime::make_sample<msgs::avs_msgs::StageTiming>();
     runtime::to_ros_time(now, timing->header.stamp);
-    runtime::set_string(timing->header.frame_id, "camera");
+    runtime::set_string(timing->header.frame_id, geometry::frame::kCameraOptical);
     runtime::set_string(timing->stage, "render");
     timing->processing_ms = ms;
     timing_.publish(std::move(timing));
@@ -360,10 +361,10 @@ class SimScene final : public runtime::Component {
   void publish_pattern(const SimFrame& frame, runtime::Time stamp) {
     auto m = runtime::make_sample<msgs::avs_msgs::PatternFrame>();
     runtime::to_ros_time(stamp, m->header.stamp);
-    runtime::set_string(m->header.frame_id, "camera");
+    runtime::set_string(m->header.frame_id, geometry::frame::kCameraOptical);
     auto& image = m->image;
     image.header.stamp = m->header.stamp;
-    runtime::set_string(image.header.frame_id, "camera");
+    runtime::set_string(image.header.frame_id, geometry::frame::kCameraOptical);
     runtime::set_string(image.encoding, "mono8");
     image.width = static_cast<std::uint32_t>(frame.image.width);
     image.height = static_cast<std::uint32_t>(frame.image.height);
@@ -384,7 +385,7 @@ class SimScene final : public runtime::Component {
     for (const ObjectTruth& o : frame.truth.objects) {
       auto m = runtime::make_sample<msgs::avs_msgs::GroundTruth>();
       runtime::to_ros_time(stamp, m->header.stamp);
-      runtime::set_string(m->header.frame_id, "world");
+      runtime::set_string(m->header.frame_id, geometry::frame::kWorld);
       runtime::set_string(m->object_name, o.name);
       msg::to_pose(o.T_world_object, m->pose_world);
       msg::to_pose(o.T_camera_object, m->pose_camera);

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 
 #include "avs/decode/sensor_geometry.hpp"
+#include "avs/geometry/frames.hpp"
 #include "avs/msg/camera_info.hpp"
 #include "avs/runtime/component.hpp"
 
@@ -70,7 +71,7 @@ class TestDepthTarget final : public runtime::Component {
   void on_activate() override {
     auto info = runtime::make_sample<msgs::sensor_msgs::CameraInfo>();
     msg::to_camera_info(camera_, *info);
-    runtime::set_string(info->header.frame_id, "camera");
+    runtime::set_string(info->header.frame_id, geometry::frame::kCameraOptical);
     camera_info_.publish(std::move(info));
     context().create_timer(period_, [this] { render(); });
   }
@@ -88,7 +89,7 @@ class TestDepthTarget final : public runtime::Component {
 
     auto image = runtime::make_sample<msgs::sensor_msgs::Image>();
     runtime::to_ros_time(now, image->header.stamp);
-    runtime::set_string(image->header.frame_id, "camera");
+    runtime::set_string(image->header.frame_id, geometry::frame::kCameraOptical);
     runtime::set_string(image->encoding, "32FC1");
     image->width = static_cast<std::uint32_t>(width_);
     image->height = static_cast<std::uint32_t>(height_);

@@ -37,7 +37,15 @@ struct HeadAngles {
 /// Rotation from the camera optical frame to the head frame (X forward, Y left, Z up).
 Eigen::Matrix3d R_head_optical();
 
+/// The head's links (frames.hpp): pan_link in the world, T(p_world_pan) Rz(-q1).
+Eigen::Isometry3d T_world_pan(const HeadConfig& head, double q1_pan_rad);
+/// tilt_link in pan_link: T(p_pan_tilt) Ry(q2).
+Eigen::Isometry3d T_pan_tilt(const HeadConfig& head, double q2_tilt_rad);
+/// camera_optical_frame in tilt_link (fixed): T(p_tilt_camera) R_head_optical.
+Eigen::Isometry3d T_tilt_camera(const HeadConfig& head);
+
 /// Pose of the camera optical frame (x right, y down, z forward) in the world:
+/// T_world_pan * T_pan_tilt * T_tilt_camera =
 /// T(p_world_pan) Rz(-q1) T(p_pan_tilt) Ry(q2) T(p_tilt_camera) R_head_optical.
 Eigen::Isometry3d T_world_camera(const HeadConfig& head, double q1_pan_rad, double q2_tilt_rad);
 

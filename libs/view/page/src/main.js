@@ -1,0 +1,248 @@
+// The live page of `avs view` (docs/view.md): connects back to the server it came from with
+// the Foxglove WebSocket client, decodes the CDR messages with the advertised ros2msg
+// schemas, and draws the depth map, the pose and the head angles. Images are asked for at
+// most max_rate_hz (default 15; ?max_rate_hz=N in the page URL), which the server applies per
+// client. window.avsView holds counters for tests.
+import {parse} from '@foxglove/rosmsg';
+import {MessageReader} from '@foxglove/rosmsg2-serialization';
+import {FoxgloveClient} from '@foxglove/ws-protocol';
+
+const WINDOW_S = 10;
+const state = (window.avsView = {
+  connected: false,
+  depthFrames: 0,
+  poseCount: 0,
+  jointCount: 0,
+  diagnosticsCount: 0,
+  channels: [],
+});
+
+const params = new URLSearchParams(location.search);
+const maxRate = Number(params.get('max_rate_hz') ?? '15');
+const ws = new WebSocket(`ws://${location.host}/?max_rate_hz=${maxRate}`, [
+  FoxgloveClient.SUPPORTED_SUBPROTOCOL,
+]);
+const client = new FoxgloveClient({ws});
+const $ = (id) => document.getElementById(id);
+
+const handlers = {
+  '/depth/image': onDepth,
+  '/object/pose': onPose,
+  '/head/joint_states': onJoints,
+  '/diagnostics': onDiagnostics,
+};
+const subscriptions = new Map();        // subscription id -> { reader, handler }
+const channelSubscription = new Map();  // channel id -> subscription id
+
+client.on('open', () => {
+  state.connected = true;
+  setStatus();
+});
+client.on('close', () => {
+  state.connected = false;
+  $('status').textContent = 'disconnected (reload the page to reconnect)';
+});
+client.on('advertise', (channels) => {
+  for (const c of channels) {
+    state.channels.push(c.topic);
+    const handler = handlers[c.topic];
+    if (!handler || c.encoding !== 'cdr' || channelSubscription.has(c.id)) continue;
+    const reader = new MessageReader(parse(c.schema, {ros2: true}));
+    const id = client.subscribe(c.id);
+    subscriptions.set(id, {reader, handler});
+    channelSubscription.set(c.id, id);
+  }
+  setStatus();
+});
+client.on('unadvertise', (ids) => {
+  for (const id of ids) {
+    const sub = channelSubscription.get(id);
+    subscriptions.delete(sub);
+    channelSubscription.delete(id);
+  }
+});
+client.on('status', (s) => console.log(`avs view status ${s.level}: ${s.message}`));
+client.on('message', ({subscriptionId, data}) => {
+  const sub = subscriptions.get(subscriptionId);
+  if (!sub) return;
+  const bytes = new Uint8Array(data.buffer, data.byteOffset, data.byteLength);
+  sub.handler(sub.reader.readMessage(bytes));
+});
+
+function setStatus() {
+  $('status').textContent =
+      `${state.connected ? 'connected' : 'connecting'} to ws://${location.host} ` +
+      `(images at most ${maxRate} Hz) | channels: ${state.channels.length} | ` +
+      `depth frames ${state.depthFrames}, poses ${state.poseCount}, joint states ${
+          state.jointCount}`;
+}
+
+const stampS = (header) => header.stamp.sec + header.stamp.nanosec * 1e-9;
+
+// ---- depth: 32FC1 metres, red near, blue far (HSV hue 0..240 deg), black where NaN ----
+function onDepth(m) {
+  if (m.encoding !== '32FC1' || m.width * m.height * 4 > m.data.byteLength) return;
+  const view = new DataView(m.data.buffer, m.data.byteOffset, m.data.byteLength);
+  const little = !m.is_bigendian;
+  const n = m.width * m.height;
+  const depth = new Float32Array(n);
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (let y = 0; y < m.height; y++) {
+    for (let x = 0; x < m.width; x++) {
+      const d = view.getFloat32(y * m.step + x * 4, little);
+      depth[y * m.width + x] = d;
+      if (Number.isFinite(d) && d > 0) {
+        if (d < lo) lo = d;
+        if (d > hi) hi = d;
+      }
+    }
+  }
+  const canvas = $('depth');
+  if (canvas.width !== m.width || canvas.height !== m.height) {
+    canvas.width = m.width;
+    canvas.height = m.height;
+  }
+  const ctx = canvas.getContext('2d');
+  const image = ctx.createImageData(m.width, m.height);
+  const span = hi > lo ? hi - lo : 1;
+  for (let i = 0; i < n; i++) {
+    const d = depth[i];
+    let r = 0, g = 0, b = 0;
+    if (Number.isFinite(d) && d > 0) {
+      [r, g, b] = hue((240 * (d - lo)) / span);
+    }
+    image.data[4 * i] = r;
+    image.data[4 * i + 1] = g;
+    image.data[4 * i + 2] = b;
+    image.data[4 * i + 3] = 255;
+  }
+  ctx.putImageData(image, 0, 0);
+  // The image centre (cross).
+  ctx.strokeStyle = '#fff';
+  ctx.beginPath();
+  ctx.moveTo(m.width / 2 - 6, m.height / 2);
+  ctx.lineTo(m.width / 2 + 6, m.height / 2);
+  ctx.moveTo(m.width / 2, m.height / 2 - 6);
+  ctx.lineTo(m.width / 2, m.height / 2 + 6);
+  ctx.stroke();
+  state.depthFrames++;
+  $('depth-legend').textContent = Number.isFinite(lo) ?
+      `${m.width}x${m.height}, ${lo.toFixed(3)} m (red) .. ${hi.toFixed(3)} m (blue), ` +
+          `stamp ${stampS(m.header).toFixed(3)} s, frame ${m.header.frame_id}` :
+      'no valid depth in the last image';
+  setStatus();
+}
+
+function hue(h) {
+  const x = 1 - Math.abs(((h / 60) % 2) - 1);
+  const [r, g, b] = h < 60 ? [1, x, 0] : h < 120 ? [x, 1, 0] : h < 180 ? [0, 1, x] : [0, x, 1];
+  return [255 * r, 255 * g, 255 * b];
+}
+
+// ---- time series over the last WINDOW_S seconds of message stamps ----
+class Series {
+  constructor() {
+    this.t = [];
+    this.v = [];
+  }
+  push(t, values) {
+    this.t.push(t);
+    this.v.push(values);
+    const start = t - WINDOW_S;
+    let k = 0;
+    while (k < this.t.length && this.t[k] < start) k++;
+    if (k > 0) {
+      this.t.splice(0, k);
+      this.v.splice(0, k);
+    }
+  }
+}
+
+function plot(canvas, series, labels, colors) {
+  const ctx = canvas.getContext('2d');
+  const w = canvas.width;
+  const h = canvas.height;
+  ctx.fillStyle = '#fff';
+  ctx.fillRect(0, 0, w, h);
+  if (series.t.length < 2) return;
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (const values of series.v) {
+    for (const v of values) {
+      if (v < lo) lo = v;
+      if (v > hi) hi = v;
+    }
+  }
+  if (hi - lo < 1e-9) {
+    hi += 0.5;
+    lo -= 0.5;
+  }
+  const t1 = series.t[series.t.length - 1];
+  const t0 = t1 - WINDOW_S;
+  const left = 50;
+  const X = (t) => left + ((w - left - 5) * (t - t0)) / WINDOW_S;
+  const Y = (v) => h - 15 - ((h - 25) * (v - lo)) / (hi - lo);
+  ctx.fillStyle = '#444';
+  ctx.font = '11px sans-serif';
+  ctx.fillText(hi.toFixed(1), 2, 12);
+  ctx.fillText(lo.toFixed(1), 2, h - 15);
+  ctx.fillText(`-${WINDOW_S} s`, left, h - 2);
+  ctx.fillText('now', w - 30, h - 2);
+  labels.forEach((label, j) => {
+    ctx.strokeStyle = colors[j];
+    ctx.beginPath();
+    series.t.forEach((t, k) => {
+      const x = X(t);
+      const y = Y(series.v[k][j]);
+      if (k === 0)
+        ctx.moveTo(x, y);
+      else
+        ctx.lineTo(x, y);
+    });
+    ctx.stroke();
+    ctx.fillStyle = colors[j];
+    ctx.fillText(label, left + 10 + 60 * j, 12);
+  });
+}
+
+const poseSeries = new Series();
+const jointSeries = new Series();
+
+function onPose(m) {
+  const p = m.pose.position;
+  const q = m.pose.orientation;
+  const t = stampS(m.header);
+  poseSeries.push(t, [p.x * 1e3, p.y * 1e3, p.z * 1e3]);
+  state.poseCount++;
+  state.lastPose = {t, p, q};
+  $('pose-readout').textContent = `stamp ${t.toFixed(3)} s, frame ${m.header.frame_id}\n` +
+      `position (mm)  x ${(p.x * 1e3).toFixed(2)}  y ${(p.y * 1e3).toFixed(2)}  z ${
+                                      (p.z * 1e3).toFixed(2)}\n` +
+      `quaternion     x ${q.x.toFixed(4)}  y ${q.y.toFixed(4)}  z ${q.z.toFixed(4)}  w ${
+                                      q.w.toFixed(4)}`;
+}
+
+function onJoints(m) {
+  const pan = m.name.indexOf('pan');
+  const tilt = m.name.indexOf('tilt');
+  if (pan < 0 || tilt < 0) return;
+  const deg = 180 / Math.PI;
+  jointSeries.push(stampS(m.header), [m.position[pan] * deg, m.position[tilt] * deg]);
+  state.jointCount++;
+}
+
+function onDiagnostics(m) {
+  state.diagnosticsCount++;
+  const lines = m.status.map(
+      (s) => `${['OK', 'WARN', 'ERROR', 'STALE'][s.level] ?? s.level} ${s.name}: ${s.message}`,
+  );
+  $('diagnostics').textContent = lines.slice(0, 20).join('\n');
+}
+
+function frame() {
+  plot($('pose-plot'), poseSeries, ['x', 'y', 'z'], ['#d33', '#3a3', '#33d']);
+  plot($('joint-plot'), jointSeries, ['pan', 'tilt'], ['#d33', '#33d']);
+  requestAnimationFrame(frame);
+}
+requestAnimationFrame(frame);

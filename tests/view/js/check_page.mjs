@@ -1,0 +1,85 @@
+// The `avs view` page in a real browser (issue 17): headless Chromium (Debian's, driven by
+// puppeteer-core) opens http://HOST:PORT/ while view_test_publisher runs, waits until the
+// page has drawn depth frames and poses, checks that the depth canvas is not blank (most
+// pixels coloured, both ends of the colour map present) and that the pose readout changes,
+// and saves a screenshot. Waits are for conditions, with generous timeouts.
+// usage: node check_page.mjs http://127.0.0.1:PORT/ SCREENSHOT.png [JOINT_STATES]
+// (JOINT_STATES: joint states the page must have drawn before the screenshot, default 200;
+// docs/img/view_page.png was taken during `avs demo --view` with 4000.)
+import { createRequire } from "node:module";
+
+const require = createRequire(import.meta.url);
+const puppeteer = require("puppeteer-core");
+
+const [url, screenshot, jointStates = "200"] = process.argv.slice(2);
+const TIMEOUT_MS = 60000;
+const chromium = process.env.AVS_CHROMIUM ?? "/usr/bin/chromium";
+
+async function main() {
+  const browser = await puppeteer.launch({
+    executablePath: chromium,
+    headless: true,
+    // Root in a container: no sandbox; no GPU on the test machines; a small /dev/shm.
+    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1280,900"],
+    defaultViewport: { width: 1280, height: 900 },
+    protocolTimeout: 20 * TIMEOUT_MS,
+  });
+  let failures = 0;
+  const check = (ok, what) => {
+    if (!ok) {
+      failures++;
+      console.error(`FAILED: ${what}`);
+    }
+  };
+  try {
+    const page = await browser.newPage();
+    page.on("console", (m) => console.log(`page: ${m.text()}`));
+    page.on("pageerror", (e) => {
+      failures++;
+      console.error(`FAILED: page error: ${e.message}`);
+    });
+    await page.goto(url, { waitUntil: "load", timeout: TIMEOUT_MS });
+    await page.waitForFunction(
+      () => window.avsView && window.avsView.depthFrames >= 3 && window.avsView.poseCount >= 10 &&
+        window.avsView.jointCount >= 10,
+      { timeout: TIMEOUT_MS, polling: 100 },
+    );
+    const pixels = await page.evaluate(() => {
+      const c = document.getElementById("depth");
+      const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+      let coloured = 0, red = 0, blue = 0;
+      for (let i = 0; i < d.length; i += 4) {
+        if (d[i] + d[i + 1] + d[i + 2] > 0) coloured++;
+        if (d[i] > 200 && d[i + 2] < 60) red++;
+        if (d[i + 2] > 200 && d[i] < 60) blue++;
+      }
+      return { total: d.length / 4, coloured, red, blue };
+    });
+    console.log(`depth canvas: ${JSON.stringify(pixels)}`);
+    check(pixels.coloured > 0.9 * pixels.total, "the depth canvas is not blank");
+    check(pixels.red > 0 && pixels.blue > 0, "near (red) and far (blue) both drawn");
+    const first = await page.$eval("#pose-readout", (e) => e.textContent);
+    await page.waitForFunction(
+      (before) => document.getElementById("pose-readout").textContent !== before,
+      { timeout: TIMEOUT_MS, polling: 100 },
+      first,
+    );
+    const second = await page.$eval("#pose-readout", (e) => e.textContent);
+    console.log(`pose readout changed:\n${first}\n->\n${second}`);
+    check(second.includes("camera_optical_frame"), "the pose readout names its frame");
+    // Let the plots fill a little before the picture.
+    await page.waitForFunction((n) => window.avsView.jointCount >= n, { timeout: 10 * TIMEOUT_MS },
+      Number(jointStates));
+    await page.screenshot({ path: screenshot });
+    console.log(`screenshot: ${screenshot}`);
+  } finally {
+    await browser.close();
+  }
+  console.log(failures === 0 ? "page check: all passed" : `page check: ${failures} failures`);
+  process.exit(failures === 0 ? 0 : 1);
+}
+
+main().catch((e) => {
+  console.error(`FAILED: ${e.message}`);
+  process.exit(1);
+});
