@@ -5,6 +5,11 @@ function(avs_apply_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-missing-field-initializers
     # GCC 12 reports false -Wrestrict positives inside std::string (GCC bug 105329).
     -Wno-restrict)
+  # A unity build includes .cpp files into one another: GCC then reports types of a file's
+  # anonymous namespace used by its own classes as if they came from a header.
+  if(CMAKE_UNITY_BUILD)
+    target_compile_options(${target} PRIVATE -Wno-subobject-linkage)
+  endif()
   if(AVS_WERROR)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
