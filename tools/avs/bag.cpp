@@ -18,24 +18,11 @@
 #include "avs/runtime/error.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
+#include "interrupts.hpp"
 
 namespace avs::cli {
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_signal(int) {
-  g_stop = true;
-}
-
-void install_signal_handlers() {
-  g_stop = false;
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-}
 
 std::string human_bytes(double bytes) {
   char buf[32];
@@ -67,14 +54,14 @@ int run_record(RecordArgs& a) {
   }
   a.options.compression = *compression;
   a.options.queue_bytes = static_cast<std::uint64_t>(a.queue_mb * 1e6);
-  install_signal_handlers();
+  stop_on_interrupt();
   bag::Recorder recorder(a.options);
   recorder.start();
   const bool tty = isatty(STDERR_FILENO) != 0;
   const auto start = std::chrono::steady_clock::now();
   auto last = start;
   bag::RecorderStatus previous = recorder.status();
-  while (!g_stop) {
+  while (!stop_requested()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const auto now = std::chrono::steady_clock::now();
     if (a.duration_s > 0 && now - start >= std::chrono::duration<double>(a.duration_s)) break;
@@ -152,7 +139,7 @@ int run_play(PlayArgs& a) {
     }
     a.options.remaps[r.substr(0, sep)] = r.substr(sep + 2);
   }
-  install_signal_handlers();
+  stop_on_interrupt();
   std::atomic<bool> paused{false};
   std::atomic<bool> done{false};
   RawTerminal terminal;
@@ -165,13 +152,13 @@ int run_play(PlayArgs& a) {
         char c = 0;
         if (read(STDIN_FILENO, &c, 1) != 1) continue;
         if (c == ' ') paused = !paused;
-        if (c == 'q') g_stop = true;
+        if (c == 'q') stop_requested() = true;
       }
     });
   }
   const bool tty = isatty(STDERR_FILENO) != 0;
   bag::PlayControl control;
-  control.stop = &g_stop;
+  control.stop = &stop_requested();
   control.paused = &paused;
   if (tty) {
     control.on_progress = [](const bag::PlayProgress& p) {

@@ -20,6 +20,7 @@
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
+#include "interrupts.hpp"
 
 namespace avs::cli {
 
@@ -61,23 +62,11 @@ std::string describe_qos(const dds_qos_t* qos) {
   return s;
 }
 
-volatile std::sig_atomic_t g_topic_interrupted = 0;
-void on_interrupt(int) {
-  g_topic_interrupted = 1;
-}
-
-/// Ctrl-C and SIGTERM end a topic command cleanly (the wait for a publisher too). Installed
-/// when a topic command runs, not when it is registered: other commands keep the defaults.
-void handle_interrupts() {
-  std::signal(SIGINT, on_interrupt);
-  std::signal(SIGTERM, on_interrupt);
-}
-
 /// Sleeps `wait`, in slices, until it is over or an interrupt came; throws on the interrupt.
 void sleep_unless_interrupted(std::chrono::milliseconds wait) {
   const auto end = Clock::now() + wait;
   while (Clock::now() < end) {
-    if (g_topic_interrupted) throw runtime::Error("interrupted");
+    if (stop_requested()) throw runtime::Error("interrupted");
     std::this_thread::sleep_for(
         std::min<Clock::duration>(std::chrono::milliseconds(50), end - Clock::now()));
   }
@@ -217,7 +206,7 @@ void add_common(Command* cmd, CommonOptions& o, bool needs_topic) {
 }
 
 bool should_stop(const CommonOptions& o, Clock::time_point start) {
-  if (g_topic_interrupted) return true;
+  if (stop_requested()) return true;
   return o.duration_s > 0 && Clock::now() - start > std::chrono::duration<double>(o.duration_s);
 }
 
@@ -331,7 +320,7 @@ void add_topic_command(Command& app) {
   add_common(list, list_o, false);
   list->add_flag("-v,--verbose", verbose, "show DDS type names and each endpoint's QoS");
   list->callback([] {
-    handle_interrupts();
+    stop_on_interrupt();
     run_list(list_o, verbose);
   });
 
@@ -344,7 +333,7 @@ void add_topic_command(Command& app) {
   echo->add_option("--max-elements", yaml.max_list_elements,
                    "longest list printed in full (0: all)");
   echo->callback([] {
-    handle_interrupts();
+    stop_on_interrupt();
     run_echo(echo_o, yaml);
   });
 
@@ -355,7 +344,7 @@ void add_topic_command(Command& app) {
   hz->add_option("-w,--window", hz_window, "intervals in the sliding window")
       ->capture_default_str();
   hz->callback([] {
-    handle_interrupts();
+    stop_on_interrupt();
     run_rate(hz_o, false, hz_window);
   });
 
@@ -365,7 +354,7 @@ void add_topic_command(Command& app) {
   add_common(bw, bw_o, true);
   bw->add_option("-w,--window", bw_window, "messages in the sliding window")->capture_default_str();
   bw->callback([] {
-    handle_interrupts();
+    stop_on_interrupt();
     run_rate(bw_o, true, bw_window);
   });
 }

@@ -9,15 +9,11 @@
 #include "avs/view/view.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
+#include "interrupts.hpp"
 
 namespace avs::cli {
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-void on_signal(int) {
-  g_stop = true;
-}
 
 struct ViewArgs {
   std::string address = "127.0.0.1";
@@ -53,13 +49,9 @@ void run_view(const ViewArgs& a) {
                 static_cast<unsigned>(v.port()), a.web_root.c_str());
   }
   std::fflush(stdout);
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  stop_on_interrupt();
   const auto start = std::chrono::steady_clock::now();
-  while (!g_stop) {
+  while (!stop_requested()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     if (a.duration_s > 0 &&
         std::chrono::steady_clock::now() - start > std::chrono::duration<double>(a.duration_s)) {
