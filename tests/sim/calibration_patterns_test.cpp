@@ -210,5 +210,59 @@ TEST(CalibrationPatterns, APlaneDecodesToItsCodesThroughARotatedDistortedProject
   EXPECT_GE(decoded_plane_within_half_code(rotated_distorted_geometry()), 0.90);
 }
 
+TEST(CalibrationPatterns, ACheckerboardShowsItsSquaresAroundEachProjectedCorner) {
+  RendererConfig config;
+  config.geometry = rotated_distorted_geometry();
+  config.geometry.camera.k1 = -0.08;  // the camera's lens too
+  config.geometry.camera.p1 = 0.0005;
+  config.column_layout = column_layout(config.geometry.projector.width);
+  config.noise_sigma_dn = 0;
+  Renderer renderer(config);
+  const decode::SensorGeometry& g = config.geometry;
+  const Checkerboard board;  // 10 x 7 squares of 40 mm
+  const geometry::Mesh mesh = make_checkerboard_mesh(board);
+  RenderObject object;
+  object.mesh = &mesh;
+  object.checkerboard = &board;
+  object.T_camera_object = Eigen::Translation3d(0.03, -0.02, 0.8) *
+                           Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()) *
+                           Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitZ()) *
+                           Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX());
+  renderer.set_view({object});
+  MonoImage white;
+  renderer.shade(FramePattern{ProjectorFrame::kWhite, 0, true}, 0, white);
+  // Around each inner corner, the four squares' centres (a third of a square away along the
+  // board's diagonals) alternate dark / light, as the board frame says.
+  int corners = 0, right = 0, blurred_edges = 0;
+  for (int j = 0; j < board.inner_corners_y(); ++j) {
+    for (int i = 0; i < board.inner_corners_x(); ++i) {
+      ++corners;
+      bool ok = true;
+      for (const auto& [sx, sy] : {std::pair{-1, -1}, {1, -1}, {-1, 1}, {1, 1}}) {
+        const Eigen::Vector3d p_board =
+            board.corner_board_m(i, j) + Eigen::Vector3d(sx, sy, 0) * board.square_m / 3;
+        const Eigen::Vector2d uv = g.camera.project(object.T_camera_object * p_board);
+        const int value =
+            white.at(static_cast<int>(std::lround(uv.x())), static_cast<int>(std::lround(uv.y())));
+        const bool dark = board.albedo(p_board.x(), p_board.y()) == board.dark_albedo;
+        ok = ok && (dark ? value < 60 : value > 120);
+      }
+      right += ok ? 1 : 0;
+      // The corner's own pixel is a mix of the four squares.
+      const Eigen::Vector2d c =
+          g.camera.project(object.T_camera_object * board.corner_board_m(i, j));
+      const int at_corner =
+          white.at(static_cast<int>(std::lround(c.x())), static_cast<int>(std::lround(c.y())));
+      blurred_edges += at_corner > 30 && at_corner < 170 ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(right, corners);
+  EXPECT_GE(blurred_edges, corners * 9 / 10);
+  RenderObject bad = object;
+  const Checkerboard square_board{.squares_x = 6, .squares_y = 6};
+  bad.checkerboard = &square_board;
+  EXPECT_THROW(renderer.set_view({bad}), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace avs::sim

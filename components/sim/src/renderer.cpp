@@ -377,7 +377,9 @@ void Renderer::set_view(const std::vector<RenderObject>& objects) {
   std::vector<bool> moved(n, true);
   if (!full) {
     for (std::size_t o = 0; o < n; ++o) {
-      if (objects[o].mesh != last_mesh_[o]) full = true;
+      if (objects[o].mesh != last_mesh_[o] || objects[o].checkerboard != last_checkerboard_[o]) {
+        full = true;
+      }
       moved[o] = objects[o].albedo != last_albedo_[o] ||
                  objects[o].T_camera_object.matrix() != last_pose_[o];
     }
@@ -421,8 +423,10 @@ void Renderer::set_view(const std::vector<RenderObject>& objects) {
   last_mesh_.resize(n);
   last_pose_.resize(n);
   last_albedo_.resize(n);
+  last_checkerboard_.resize(n);
   for (std::size_t o = 0; o < n; ++o) {
     last_mesh_[o] = objects[o].mesh;
+    last_checkerboard_[o] = objects[o].checkerboard;
     last_pose_[o] = objects[o].T_camera_object.matrix();
     last_albedo_[o] = objects[o].albedo;
   }
@@ -448,6 +452,9 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
   triangle_object_.clear();
   triangle_albedo_dn_.clear();
   triangle_normal_dot_projector_.clear();
+  triangle_plane_offset_.clear();
+  object_checkerboard_.resize(objects.size());
+  object_T_object_camera_.resize(objects.size());
   camera_vertices_.resize(objects.size());
   projector_vertices_.resize(objects.size());
   new_camera_box_.resize(objects.size());
@@ -457,6 +464,13 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
       throw std::invalid_argument("sim::Renderer: object without mesh");
     const geometry::Mesh& mesh = *objects[o].mesh;
     const Eigen::Isometry3f T = objects[o].T_camera_object.cast<float>();
+    object_checkerboard_[o] = objects[o].checkerboard;
+    if (objects[o].checkerboard) {
+      if (const std::string why = objects[o].checkerboard->problem(); !why.empty()) {
+        throw std::invalid_argument("sim::Renderer: checkerboard: " + why);
+      }
+    }
+    object_T_object_camera_[o] = objects[o].T_camera_object.inverse();
     std::vector<Eigen::Vector3f>& camera = camera_vertices_[o];
     std::vector<Eigen::Vector3f>& projector = projector_vertices_[o];
     camera.resize(mesh.vertices.size());
@@ -472,6 +486,7 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
       triangle_albedo_dn_.push_back(kFullScaleDn * static_cast<float>(objects[o].albedo));
       triangle_normal_dot_projector_.push_back(
           normal_camera_.back().dot(projector_centre_camera_m_));
+      triangle_plane_offset_.push_back(normal_camera_.back().dot(a));
     }
     new_camera_box_[o] = screen_box(camera_view_, camera);
     new_shadow_box_[o] = screen_box(shadow_view_, projector);
@@ -495,6 +510,27 @@ void Renderer::rasterize_all(const std::vector<RenderObject>& objects, const Box
     }
     id_offset += static_cast<std::int32_t>(mesh.triangles.size());
   }
+}
+
+float Renderer::textured_albedo(std::int32_t triangle, int x, int y) const {
+  // The pixel's footprint on the triangle's plane: 4 x 4 rays through the pinhole pixel.
+  constexpr int kSamples = 4;
+  const auto o = static_cast<std::size_t>(triangle_object_[triangle]);
+  const Checkerboard& board = *object_checkerboard_[o];
+  const Eigen::Isometry3d& T_object_camera = object_T_object_camera_[o];
+  const Eigen::Vector3d n = normal_camera_[triangle].cast<double>();
+  const double offset = triangle_plane_offset_[triangle];
+  double sum = 0;
+  for (int j = 0; j < kSamples; ++j) {
+    for (int i = 0; i < kSamples; ++i) {
+      const double dx = (i + 0.5) / kSamples - 0.5, dy = (j + 0.5) / kSamples - 0.5;
+      const Eigen::Vector3d ray((x + dx - camera_view_.cx_px) / camera_view_.fx_px,
+                                (y + dy - camera_view_.cy_px) / camera_view_.fy_px, 1.0);
+      const Eigen::Vector3d p_object = T_object_camera * (ray * (offset / n.dot(ray)));
+      sum += board.albedo(p_object.x(), p_object.y());
+    }
+  }
+  return static_cast<float>(sum / (kSamples * kSamples));
 }
 
 template <bool kWithTruth>
@@ -569,7 +605,9 @@ void Renderer::compute_row(int y, Truth* truth) {
     }
     base_out[x] = gain_out[x] = 0.0f;
     if (id < 0) continue;
-    const float albedo = albedo_dn[id];
+    const float albedo = object_checkerboard_[static_cast<std::size_t>(triangle_object_[id])]
+                             ? kFullScaleDn * textured_albedo(id, x, y)
+                             : albedo_dn[id];
     base_out[x] = albedo * ambient;
     // cos(normal, direction to the projector): n.(c - p) with p = z ray, n.c per triangle.
     const Eigen::Vector3f& n = normals[id];

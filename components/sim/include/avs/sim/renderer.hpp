@@ -17,6 +17,7 @@
 
 #include "avs/decode/sensor_geometry.hpp"
 #include "avs/geometry/mesh.hpp"
+#include "avs/sim/checkerboard.hpp"
 #include "avs/sim/rasterizer.hpp"
 
 namespace avs::sim {
@@ -71,6 +72,10 @@ struct RenderObject {
   const geometry::Mesh* mesh = nullptr;
   Eigen::Isometry3d T_camera_object = Eigen::Isometry3d::Identity();
   double albedo = 0.7;
+  /// When set, the object's albedo is this printed pattern (object frame = board frame,
+  /// usually on make_checkerboard_mesh()), averaged over 4 x 4 points per camera pixel;
+  /// `albedo` is then unused. The renderer does not own it.
+  const Checkerboard* checkerboard = nullptr;
 };
 
 /// 8-bit mono image, row-major.
@@ -171,12 +176,19 @@ class Renderer {
   std::vector<std::int16_t> triangle_object_;
   std::vector<float> triangle_albedo_dn_;             ///< 255 x albedo of the triangle's object
   std::vector<float> triangle_normal_dot_projector_;  ///< n . projector centre (camera frame)
+  std::vector<float> triangle_plane_offset_;          ///< n . (a vertex), camera frame
+  /// Per object of the current view: its printed pattern (or null) and T_object_camera.
+  std::vector<const Checkerboard*> object_checkerboard_;
+  std::vector<Eigen::Isometry3d> object_T_object_camera_;
+  /// Albedo (0..1) of a textured triangle's surface averaged over camera pixel (x, y).
+  float textured_albedo(std::int32_t triangle, int x, int y) const;
   std::vector<std::vector<Eigen::Vector3f>> camera_vertices_, projector_vertices_;  ///< per object
   // State of the previous set_view() for the incremental pass.
   bool have_last_ = false;
   std::vector<const geometry::Mesh*> last_mesh_;
   std::vector<Eigen::Matrix4d> last_pose_;
   std::vector<double> last_albedo_;
+  std::vector<const Checkerboard*> last_checkerboard_;
   std::vector<Box> camera_box_, shadow_box_;          ///< per object, previous view
   std::vector<Box> new_camera_box_, new_shadow_box_;  ///< per object, current view
   /// Per camera pixel: the shadow-map cell (column, row) its last shadow test read; -1: none.
