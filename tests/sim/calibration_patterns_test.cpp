@@ -219,7 +219,7 @@ TEST(CalibrationPatterns, ACheckerboardShowsItsSquaresAroundEachProjectedCorner)
   config.noise_sigma_dn = 0;
   Renderer renderer(config);
   const decode::SensorGeometry& g = config.geometry;
-  const Checkerboard board;  // 10 x 7 squares of 40 mm
+  const Checkerboard board;  // 10 x 7 squares of 30 mm
   const geometry::Mesh mesh = make_checkerboard_mesh(board);
   RenderObject object;
   object.mesh = &mesh;

@@ -178,7 +178,11 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   base_dn_.assign(pixels, 0.0f);
   gain_dn_.assign(pixels, 0.0f);
   gray_.assign(pixels, 0);
-  if (calibration_patterns_) column_gray_.assign(pixels, 0);
+  if (calibration_patterns_) {
+    column_gray_.assign(pixels, 0);
+    sub_samples_.resize(pixels);
+    is_sub_sampled_.assign(pixels, 0);
+  }
   truth_.depth_m.assign(pixels, 0.0f);
   truth_.projector_row.assign(pixels, std::numeric_limits<float>::quiet_NaN());
   truth_.projector_column.assign(pixels, std::numeric_limits<float>::quiet_NaN());
@@ -512,25 +516,48 @@ void Renderer::rasterize_all(const std::vector<RenderObject>& objects, const Box
   }
 }
 
-float Renderer::textured_albedo(std::int32_t triangle, int x, int y) const {
+float Renderer::textured_albedo(std::int32_t triangle, int x, int y, SubSamples* sub) const {
   // The pixel's footprint on the triangle's plane: 4 x 4 rays through the pinhole pixel.
-  constexpr int kSamples = 4;
+  constexpr int kSide = 4;
+  static_assert(kSide * kSide == kSubSamples);
   const auto o = static_cast<std::size_t>(triangle_object_[triangle]);
   const Checkerboard& board = *object_checkerboard_[o];
   const Eigen::Isometry3d& T_object_camera = object_T_object_camera_[o];
   const Eigen::Vector3d n = normal_camera_[triangle].cast<double>();
   const double offset = triangle_plane_offset_[triangle];
+  const Eigen::Matrix3d R = R_projector_camera_.cast<double>();
+  const Eigen::Vector3d t = t_projector_camera_m_.cast<double>();
   double sum = 0;
-  for (int j = 0; j < kSamples; ++j) {
-    for (int i = 0; i < kSamples; ++i) {
-      const double dx = (i + 0.5) / kSamples - 0.5, dy = (j + 0.5) / kSamples - 0.5;
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      const double dx = (i + 0.5) / kSide - 0.5, dy = (j + 0.5) / kSide - 0.5;
       const Eigen::Vector3d ray((x + dx - camera_view_.cx_px) / camera_view_.fx_px,
                                 (y + dy - camera_view_.cy_px) / camera_view_.fy_px, 1.0);
-      const Eigen::Vector3d p_object = T_object_camera * (ray * (offset / n.dot(ray)));
-      sum += board.albedo(p_object.x(), p_object.y());
+      const Eigen::Vector3d p_camera = ray * (offset / n.dot(ray));
+      const Eigen::Vector3d p_object = T_object_camera * p_camera;
+      const double albedo = board.albedo(p_object.x(), p_object.y());
+      sum += albedo;
+      if (sub == nullptr) continue;
+      const int s = j * kSide + i;
+      sub->albedo[s] = static_cast<std::uint8_t>(std::lround(255 * albedo));
+      sub->row_gray[s] = sub->column_gray[s] = 0;
+      const Eigen::Vector3d q = R * p_camera + t;
+      if (!(q.z() > config_.near_clip_m)) continue;
+      const Eigen::Vector2d uv = projector_.project(q);  // with the projector's distortion
+      if (!projector_.contains(uv)) continue;
+      const int row = row_code_[static_cast<std::size_t>(uv.y() + 0.5)];
+      const int column = column_code_[static_cast<std::size_t>(uv.x() + 0.5)];
+      if (row >= 0) {
+        sub->row_gray[s] = static_cast<std::uint16_t>(
+            kCoded | decode::binary_to_gray(static_cast<std::uint32_t>(row)));
+      }
+      if (column >= 0) {
+        sub->column_gray[s] = static_cast<std::uint16_t>(
+            kCoded | decode::binary_to_gray(static_cast<std::uint32_t>(column)));
+      }
     }
   }
-  return static_cast<float>(sum / (kSamples * kSamples));
+  return static_cast<float>(sum / kSubSamples);
 }
 
 template <bool kWithTruth>
@@ -594,7 +621,10 @@ void Renderer::compute_row(int y, Truth* truth) {
   for (int x = 0; x < width; ++x) {
     const std::int32_t id = ids[x];
     gray_out[x] = 0;
-    if (calibration) column_gray_out[x] = 0;
+    if (calibration) {
+      column_gray_out[x] = 0;
+      is_sub_sampled_[row_start + x] = 0;
+    }
     cell_u_out[x] = cell_v_out[x] = -1;
     if constexpr (kWithTruth) {
       truth->projector_row[row_start + x] = kNaN;
@@ -605,9 +635,11 @@ void Renderer::compute_row(int y, Truth* truth) {
     }
     base_out[x] = gain_out[x] = 0.0f;
     if (id < 0) continue;
-    const float albedo = object_checkerboard_[static_cast<std::size_t>(triangle_object_[id])]
-                             ? kFullScaleDn * textured_albedo(id, x, y)
-                             : albedo_dn[id];
+    const bool textured =
+        object_checkerboard_[static_cast<std::size_t>(triangle_object_[id])] != nullptr;
+    SubSamples* sub = textured && calibration ? &sub_samples_[row_start + x] : nullptr;
+    if (calibration) is_sub_sampled_[row_start + x] = sub != nullptr;
+    const float albedo = textured ? kFullScaleDn * textured_albedo(id, x, y, sub) : albedo_dn[id];
     base_out[x] = albedo * ambient;
     // cos(normal, direction to the projector): n.(c - p) with p = z ray, n.c per triangle.
     const Eigen::Vector3f& n = normals[id];
@@ -644,6 +676,7 @@ void Renderer::compute_row(int y, Truth* truth) {
     float irradiance = projector_level * facing * inv_distance[x];
     if (falloff2 > 0) irradiance *= falloff2 * inv_distance[x] * inv_distance[x];
     gain_out[x] = albedo * irradiance;
+    if (sub != nullptr) gain_out[x] = kFullScaleDn * irradiance;  // albedo per sub-sample
     if constexpr (kWithTruth) {
       truth->projector_column[row_start + x] = u;
       if (code >= 0) {
@@ -708,9 +741,23 @@ void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoI
     throw std::logic_error(
         "sim::Renderer: white and column-code frames need RendererConfig::column_layout");
   }
+  // Sub-sampled pixels (a printed target, calibration patterns): the pattern's light
+  // integrated over the pixel, sub-sample by sub-sample with its own albedo.
+  const std::uint8_t* sub_sampled = is_sub_sampled_.data();
+  const SubSamples* subs = sub_samples_.data();
+  constexpr float kSubScale = 1.0f / (kSubSamples * kFullScaleDn);
   if (pattern.frame == ProjectorFrame::kWhite) {
     quantise(
-        noise_key, [&](std::size_t i) { return base[i] + gain[i]; }, out);
+        noise_key,
+        [&](std::size_t i) {
+          if (!sub_sampled[i]) return base[i] + gain[i];
+          int sum = 0;
+          for (int s = 0; s < kSubSamples; ++s) {
+            sum += subs[i].albedo[s] * ((subs[i].row_gray[s] | subs[i].column_gray[s]) >> 15);
+          }
+          return base[i] + gain[i] * kSubScale * static_cast<float>(sum);
+        },
+        out);
     return;
   }
   const bool columns = pattern.frame == ProjectorFrame::kColumnBit;
@@ -723,13 +770,25 @@ void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoI
   const int shift = bit_count - 1 - pattern.bit_index;  // Eq. 1: k = 0 is the MSB
   const unsigned flip = pattern.positive ? 0u : 1u;
   const std::uint16_t* gray = columns ? column_gray_.data() : gray_.data();
+  const auto bit_of = [shift, flip](unsigned g) {
+    // Uncoded pixels (no kCoded flag) are dark in both polarities.
+    return (((g >> shift) & 1u) ^ flip) & (g >> 15);
+  };
+  if (!calibration_patterns_) {
+    quantise(
+        noise_key,
+        [&](std::size_t i) { return base[i] + gain[i] * static_cast<float>(bit_of(gray[i])); },
+        out);
+    return;
+  }
   quantise(
       noise_key,
       [&](std::size_t i) {
-        // Uncoded pixels (no kCoded flag) are dark in both polarities.
-        const auto g = static_cast<unsigned>(gray[i]);
-        const unsigned bit = (((g >> shift) & 1u) ^ flip) & (g >> 15);
-        return base[i] + gain[i] * static_cast<float>(bit);
+        if (!sub_sampled[i]) return base[i] + gain[i] * static_cast<float>(bit_of(gray[i]));
+        const std::uint16_t* sub_gray = columns ? subs[i].column_gray : subs[i].row_gray;
+        int sum = 0;
+        for (int s = 0; s < kSubSamples; ++s) sum += subs[i].albedo[s] * bit_of(sub_gray[s]);
+        return base[i] + gain[i] * kSubScale * static_cast<float>(sum);
       },
       out);
 }

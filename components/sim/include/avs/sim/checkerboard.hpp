@@ -16,8 +16,8 @@ namespace avs::sim {
 struct Checkerboard {
   int squares_x = 10;  ///< squares along x (inner corners: squares_x - 1)
   int squares_y = 7;   ///< squares along y
-  double square_m = 0.04;
-  double margin_m = 0.03;  ///< light border around the squares
+  double square_m = 0.03;
+  double margin_m = 0.03;  ///< light border around the squares (one square, for the detector)
   double dark_albedo = 0.12;
   double light_albedo = 0.8;
 

@@ -180,8 +180,21 @@ class Renderer {
   /// Per object of the current view: its printed pattern (or null) and T_object_camera.
   std::vector<const Checkerboard*> object_checkerboard_;
   std::vector<Eigen::Isometry3d> object_T_object_camera_;
-  /// Albedo (0..1) of a textured triangle's surface averaged over camera pixel (x, y).
-  float textured_albedo(std::int32_t triangle, int x, int y) const;
+  /// A textured pixel's 4 x 4 sub-samples (calibration patterns only): each one's albedo
+  /// (x 255) and the Gray codes (with kCoded) of the row and column that light it, so that a
+  /// frame integrates the pattern over the pixel as a sensor does (stripe edges then blur
+  /// without the bias that point-sampled stripes get from the lens distortion remap).
+  static constexpr int kSubSamples = 16;
+  struct SubSamples {
+    std::uint16_t row_gray[kSubSamples];
+    std::uint16_t column_gray[kSubSamples];
+    std::uint8_t albedo[kSubSamples];
+  };
+  /// Albedo (0..1) of a textured triangle's surface averaged over pinhole pixel (x, y); fills
+  /// `sub` when given.
+  float textured_albedo(std::int32_t triangle, int x, int y, SubSamples* sub) const;
+  std::vector<SubSamples> sub_samples_;       ///< per pinhole pixel (calibration patterns only)
+  std::vector<std::uint8_t> is_sub_sampled_;  ///< per pinhole pixel: sub_samples_ is valid
   std::vector<std::vector<Eigen::Vector3f>> camera_vertices_, projector_vertices_;  ///< per object
   // State of the previous set_view() for the incremental pass.
   bool have_last_ = false;
