@@ -189,6 +189,36 @@ CalibrationResult solve_calibration(const CaptureInfo& info,
   return result;
 }
 
+decode::GrayImage8 coverage_image(const CaptureInfo& info,
+                                  const std::vector<ViewObservation>& views,
+                                  const CalibrationResult& result, bool projector) {
+  decode::GrayImage8 image;
+  image.width = projector ? info.codes.projector_width : info.camera_width;
+  image.height = projector ? info.codes.projector_height : info.camera_height;
+  image.pixels.assign(static_cast<std::size_t>(image.width) * image.height, 0);
+  const auto set = [&image](int x, int y, std::uint8_t value) {
+    if (x >= 0 && y >= 0 && x < image.width && y < image.height) {
+      image.pixels[static_cast<std::size_t>(y) * image.width + x] = value;
+    }
+  };
+  for (int k = 1; k < 4; ++k) {  // the coverage grid
+    for (int x = 0; x < image.width; ++x) set(x, k * image.height / 4, 80);
+    for (int y = 0; y < image.height; ++y) set(k * image.width / 4, y, 80);
+  }
+  for (std::size_t v = 0; v < views.size() && v < result.views.size(); ++v) {
+    if (!result.views[v].used) continue;
+    for (const CornerObservation& c : views[v].corners) {
+      if (!c.has_projector) continue;
+      const Eigen::Vector2d p = projector ? c.projector_px : c.camera_px;
+      const int x = static_cast<int>(std::lround(p.x())), y = static_cast<int>(std::lround(p.y()));
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) set(x + dx, y + dy, 255);
+      }
+    }
+  }
+  return image;
+}
+
 std::string summary_text(const CalibrationResult& r) {
   std::ostringstream out;
   char line[512];

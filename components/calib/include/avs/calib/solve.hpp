@@ -25,7 +25,7 @@ struct SolveConfig {
   /// (unstable codes: projector gamma, exposure, defocus).
   double max_undecoded_fraction = 0.3;
   /// A view whose board covers less than this fraction of the camera image is not used.
-  double min_board_area_fraction = 0.01;
+  double min_board_area_fraction = 0.005;
   /// Estimate k3 too (off: k3 = 0, the usual choice for moderate lenses and few views).
   bool estimate_k3 = false;
   /// Estimate the projector's k2 (off: k2 = k3 = 0). The camera sees only the middle of the
@@ -63,6 +63,12 @@ struct CalibrationResult {
 CalibrationResult solve_calibration(const CaptureInfo& info,
                                     const std::vector<ViewObservation>& views,
                                     const SolveConfig& config = {});
+
+/// The coverage picture: the corners of the used views over the camera's (or the
+/// projector's) image, one 3 x 3 dot each, on the 4 x 4 grid the coverage check counts.
+decode::GrayImage8 coverage_image(const CaptureInfo& info,
+                                  const std::vector<ViewObservation>& views,
+                                  const CalibrationResult& result, bool projector);
 
 /// A short text summary (per-view errors, figures, refusals).
 std::string summary_text(const CalibrationResult& result);
