@@ -193,10 +193,17 @@ std::vector<Eigen::Isometry3d> generate_board_poses(const decode::SensorGeometry
     bool placed = false;
     for (int attempt = 0; attempt < 2000 && !placed; ++attempt) {
       const double z = uniform(z0, z1);
-      // Anywhere the camera sees at that distance (the visibility test decides).
-      const double half_x = 0.5 * z * geometry.camera.width / geometry.camera.fx_px;
-      const double half_y = 0.5 * z * geometry.camera.height / geometry.camera.fy_px;
-      const Eigen::Vector3d xyz(uniform(-half_x, half_x), uniform(-half_y, half_y), z);
+      // The board's centre towards one of 3 x 3 regions of the camera image in turn (so that
+      // the corners of all views spread over the image), jittered; after 200 misses anywhere
+      // the camera sees at that distance. The visibility test decides.
+      const int region = (k * 4) % 9;  // 0, 4, 8, 3, 7, 2, 6, 1, 5: distance and region mixed
+      const double spread = attempt < 200 ? 1.0 / 3.0 : 1.0;
+      const double u =
+          (attempt < 200 ? (region % 3 + 0.5) / 3.0 : 0.5) + uniform(-0.5, 0.5) * spread;
+      const double v =
+          (attempt < 200 ? (region / 3 + 0.5) / 3.0 : 0.5) + uniform(-0.5, 0.5) * spread;
+      const Eigen::Vector3d xyz = z * geometry.camera.ray(u * (geometry.camera.width - 1),
+                                                          v * (geometry.camera.height - 1));
       const Eigen::Vector3d rpy(180.0 + uniform(-max_tilt_deg, max_tilt_deg),
                                 uniform(-max_tilt_deg, max_tilt_deg), uniform(-20.0, 20.0));
       const Eigen::Isometry3d T = pose_from_xyz_rpy(xyz, rpy);

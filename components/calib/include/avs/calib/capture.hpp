@@ -103,10 +103,11 @@ PoseVisibility pose_visibility(const decode::SensorGeometry& geometry,
                                const Eigen::Isometry3d& T_camera_board, double margin_px = 10);
 
 /// A seeded spread of `count` board poses over [near_m, far_m] (board centre z, evenly
-/// stratified), tilted up to `max_tilt_deg` about the board's x and y axes and turned up to
-/// 20 deg about its normal, placed where the whole board is in view of the camera and the
-/// projector. Deterministic for a seed on every platform (own uniform generator). Throws if
-/// a pose cannot be placed (the board does not fit the views at near_m).
+/// stratified; centres towards the 3 x 3 regions of the camera image in turn), tilted up to
+/// `max_tilt_deg` about the board's x and y axes and turned up to 20 deg about its normal, placed
+/// where the whole board is in view of the camera and the projector. Deterministic for a seed on
+/// every platform (own uniform generator). Throws if a pose cannot be placed (the board does not
+/// fit the views at near_m).
 std::vector<Eigen::Isometry3d> generate_board_poses(const decode::SensorGeometry& geometry,
                                                     const sim::Checkerboard& board, int count,
                                                     double near_m, double far_m,
