@@ -136,6 +136,12 @@ TEST(CalibrationPatterns, WhiteAndColumnFramesNeedTheColumnLayout) {
                std::logic_error);
   EXPECT_THROW(renderer.shade(FramePattern{ProjectorFrame::kRowBit, 9, true}, 0, image),
                std::invalid_argument);
+  // With calibration patterns, motion blur (which ignores the per-pixel sub-samples) refuses.
+  RendererConfig calibration;
+  calibration.column_layout = column_layout(calibration.geometry.projector.width);
+  Renderer calibration_renderer(calibration);
+  std::vector<float> sum;
+  EXPECT_THROW(calibration_renderer.accumulate(0, true, 1.0f, sum), std::logic_error);
 }
 
 /// Decodes one cycle of a plane at 1 m; returns the fraction of coded pixels whose depth error

@@ -795,6 +795,10 @@ void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoI
 
 void Renderer::accumulate(int bit_index, bool positive, float weight,
                           std::vector<float>& sum) const {
+  if (calibration_patterns_) {
+    // Sub-sampled pixels keep their albedo per sub-sample, which this sum does not read.
+    throw std::logic_error("sim::Renderer: motion blur is not rendered with calibration patterns");
+  }
   sum.resize(base_dn_.size(), 0.0f);
   const int shift = config_.geometry.layout.bit_count - 1 - bit_index;
   const unsigned flip = positive ? 0u : 1u;

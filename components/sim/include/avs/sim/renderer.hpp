@@ -110,7 +110,8 @@ class Renderer {
   void shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out) const;
 
   /// Motion blur: adds weight x the noise-free intensity (DN) of the current view to `sum`
-  /// (width*height floats); finish() adds noise and quantises.
+  /// (width*height floats); finish() adds noise and quantises. Row codes only: throws
+  /// std::logic_error with calibration patterns (RendererConfig::column_layout).
   void accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum) const;
   void finish(const std::vector<float>& sum, std::uint64_t noise_key, MonoImage& out) const;
 
