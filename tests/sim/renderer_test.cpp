@@ -131,9 +131,26 @@ TEST(Renderer, CameraLensDistortionIsRenderedAlongEachPixelsTrueRay) {
   EXPECT_EQ(distorted.height(), 512);
 }
 
-TEST(Renderer, RejectsProjectorLensDistortion) {
+TEST(Renderer, ProjectorLensDistortionIsRenderedAtEachPointsDmdPixel) {
+  // Barrel distortion and tangential terms on the projector: each lit point shows the pattern
+  // of the DMD pixel whose (distorted) ray meets it, i.e. decode's projector.project().
   RendererConfig config;
-  config.geometry.projector.k1 = 0.1;
+  geometry::CameraModel& p = config.geometry.projector;
+  p.k1 = -0.06;
+  p.k2 = 0.03;
+  p.p1 = 0.0008;
+  p.p2 = -0.0005;
+  const double agreement = plane_bit_agreement(config, 1e-4);
+  EXPECT_GE(agreement, 0.99);
+  // Judged by the projector's pinhole instead, the same frames disagree: it is really rendered.
+  decode::SensorGeometry pinhole = config.geometry;
+  pinhole.projector.set_distortion_coefficients({});
+  EXPECT_LT(plane_bit_agreement(config, 1e-4, &pinhole), agreement - 0.01);
+}
+
+TEST(Renderer, RejectsAProjectorDistortionThatDoesNotInvert) {
+  RendererConfig config;
+  config.geometry.projector.k1 = -3.0;  // folds back inside the DMD
   EXPECT_THROW(Renderer{config}, std::invalid_argument);
 }
 

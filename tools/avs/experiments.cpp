@@ -114,11 +114,17 @@ void add_experiments_command(Command& app) {
   static std::string out;
   static double time_scale = 1.0;
   static std::string calibration;
+  static std::string true_calibration;
   cmd->add_option("NAME", names, "experiments to run (default: all)");
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
                   "decoder only; tracking, matching and the recorder take the camera model "
                   "from /depth/camera_info (default: the paper's sensor)")
+      ->check_existing_file();
+  cmd->add_option("--true-calibration", true_calibration,
+                  "the simulated sensor's own calibration when it differs from --calibration: "
+                  "the decoder gets --calibration (e.g. one recovered by avs calib solve), the "
+                  "simulator this truth")
       ->check_existing_file();
   cmd->add_flag("--json", json, "print one JSON object keyed by scenario name on stdout");
   cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
@@ -149,6 +155,11 @@ void add_experiments_command(Command& app) {
         e.run.extra_args["calibration"] = std::filesystem::absolute(calibration).string();
         e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("calibration ") +
                        std::filesystem::path(calibration).filename().string();
+      }
+      if (!true_calibration.empty()) {
+        e.run.extra_args["true_calibration"] = std::filesystem::absolute(true_calibration).string();
+        e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("true calibration ") +
+                       std::filesystem::path(true_calibration).filename().string();
       }
       std::cerr << "== " << e.name << " (Sec. " << e.section << "): " << e.what << "\n";
       const ClosedLoopOutcome outcome = run_closed_loop(e.run, std::cerr);

@@ -8,22 +8,18 @@
 #include <yaml-cpp/yaml.h>
 #include <Eigen/LU>
 
-#include "avs/runtime/text.hpp"
+#include "avs/runtime/yaml_checks.hpp"
 
 namespace avs::decode {
 namespace {
 
 [[noreturn]] void fail(const std::string& source, const YAML::Node& node, const std::string& what) {
-  throw std::runtime_error(runtime::yaml_location(source, node.Mark()) + ": " + what);
+  runtime::yaml_fail(source, node, what);
 }
 
 void check_keys(const std::string& source, const YAML::Node& node,
                 const std::set<std::string>& allowed, const std::string& section) {
-  if (!node.IsMap()) fail(source, node, section + " must be a map");
-  for (const auto& entry : node) {
-    const auto key = entry.first.as<std::string>();
-    if (!allowed.count(key)) fail(source, entry.first, "unknown key '" + key + "' in " + section);
-  }
+  runtime::yaml_check_keys(source, node, allowed, section);
 }
 
 template <typename T>
@@ -39,19 +35,7 @@ void read(const std::string& source, const YAML::Node& map, const char* key, T& 
 
 std::vector<double> read_list(const std::string& source, const YAML::Node& node, std::size_t size,
                               const char* key) {
-  if (!node.IsSequence() || node.size() != size) {
-    fail(source, node,
-         std::string("'") + key + "' must be a list of " + std::to_string(size) + " numbers");
-  }
-  std::vector<double> values;
-  for (const auto& item : node) {
-    try {
-      values.push_back(item.as<double>());
-    } catch (const YAML::Exception&) {
-      fail(source, item, std::string("'") + key + "' must hold numbers");
-    }
-  }
-  return values;
+  return runtime::yaml_numbers(source, node, size, key);
 }
 
 void read_lens(const std::string& source, const YAML::Node& node, const std::string& section,

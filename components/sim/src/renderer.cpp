@@ -16,6 +16,8 @@ namespace {
 constexpr float kFullScaleDn = 255.0f;
 constexpr std::size_t kNoiseBankSize = std::size_t{1} << 20;
 constexpr float kNoiseBankScale = 32.0f;  ///< bank entries are N(0, 1) x 32, in int8
+/// Flag in gray_ / column_gray_: a coded row (column) lights the pixel (codes have <= 15 bits).
+constexpr std::uint16_t kCoded = 0x8000;
 
 std::uint64_t splitmix64(std::uint64_t x) {
   x += 0x9E3779B97F4A7C15ull;
@@ -96,13 +98,22 @@ std::uint64_t frame_noise_key(std::uint64_t frame_index) {
 
 Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   const decode::SensorGeometry& g = config_.geometry;
-  if (g.projector.has_distortion()) {
-    throw std::invalid_argument(
-        "sim::Renderer: projector lens distortion is not rendered yet (camera distortion is); "
-        "set the projector's distortion to 0");
-  }
   if (const std::string problem = g.camera.problem(); !problem.empty()) {
     throw std::invalid_argument("sim::Renderer: camera: " + problem);
+  }
+  if (const std::string problem = g.projector.problem(); !problem.empty()) {
+    throw std::invalid_argument("sim::Renderer: projector: " + problem);
+  }
+  if (config_.column_layout) {
+    const decode::CodeLayout& c = *config_.column_layout;
+    if (c.bit_count < 1 || c.bit_count > 15 || c.code_count < 1 ||
+        c.code_count > (1 << c.bit_count) || c.rows_per_code < 1) {
+      throw std::invalid_argument(
+          "sim::Renderer: column_layout needs 1..15 bits, 1..2^bits codes, rows_per_code >= 1");
+    }
+  }
+  if (g.layout.bit_count > 15) {
+    throw std::invalid_argument("sim::Renderer: the row code has more than 15 bits");
   }
   if (g.camera.width <= 0 || g.camera.height <= 0 || g.projector.width <= 0 ||
       g.projector.height <= 0) {
@@ -118,16 +129,30 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   const geometry::CameraModel pinhole = make_pinhole_and_remap(g.camera);
   camera_view_ = make_view(pinhole, 1.0, config_.near_clip_m);
   projector_ = g.projector;
-  shadow_view_ = make_view(g.projector, config_.shadow_map_scale, config_.near_clip_m);
-  // Only the coded rows (plus a cell of margin) matter: the others are dark in both polarities.
-  const double s = config_.shadow_map_scale;
-  shadow_view_.first_row = std::max(0, static_cast<int>(std::floor(g.layout.first_row * s)) - 1);
-  shadow_view_.last_row =
-      std::min(shadow_view_.height,
-               static_cast<int>(std::ceil((g.layout.first_row + g.layout.used_rows()) * s)) + 1);
+  calibration_patterns_ = config_.column_layout.has_value();
+  // The shadow map is rasterised in the projector's ideal pinhole (widened when it has
+  // distortion, see make_projector_pinhole).
+  shadow_view_ =
+      make_view(make_projector_pinhole(g.projector), config_.shadow_map_scale, config_.near_clip_m);
+  if (!calibration_patterns_ && !g.projector.has_distortion()) {
+    // Only the coded rows (plus a cell of margin) matter: the others are dark in both
+    // polarities.
+    const double s = config_.shadow_map_scale;
+    shadow_view_.first_row = std::max(0, static_cast<int>(std::floor(g.layout.first_row * s)) - 1);
+    shadow_view_.last_row =
+        std::min(shadow_view_.height,
+                 static_cast<int>(std::ceil((g.layout.first_row + g.layout.used_rows()) * s)) + 1);
+  }
   row_code_.resize(g.projector.height);
   for (int row = 0; row < g.projector.height; ++row) {
     row_code_[row] = static_cast<std::int16_t>(decode::code_of_row(g.layout, row));
+  }
+  if (calibration_patterns_) {
+    column_code_.resize(g.projector.width);
+    for (int column = 0; column < g.projector.width; ++column) {
+      column_code_[column] =
+          static_cast<std::int16_t>(decode::code_of_row(*config_.column_layout, column));
+    }
   }
   noise_bank_ = make_noise_bank(config_.noise_seed);
   R_projector_camera_ = g.R_projector_camera.cast<float>();
@@ -153,8 +178,14 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   base_dn_.assign(pixels, 0.0f);
   gain_dn_.assign(pixels, 0.0f);
   gray_.assign(pixels, 0);
+  if (calibration_patterns_) {
+    column_gray_.assign(pixels, 0);
+    sub_samples_.resize(pixels);
+    is_sub_sampled_.assign(pixels, 0);
+  }
   truth_.depth_m.assign(pixels, 0.0f);
   truth_.projector_row.assign(pixels, std::numeric_limits<float>::quiet_NaN());
+  truth_.projector_column.assign(pixels, std::numeric_limits<float>::quiet_NaN());
   truth_.object_index.assign(pixels, -1);
   truth_.code.assign(pixels, -1);
   shadow_cell_u_.assign(pixels, -1);
@@ -220,6 +251,50 @@ geometry::CameraModel Renderer::make_pinhole_and_remap(const geometry::CameraMod
   return pinhole;
 }
 
+geometry::CameraModel Renderer::make_projector_pinhole(const geometry::CameraModel& projector) {
+  geometry::CameraModel pinhole = projector;
+  pinhole.set_distortion_coefficients({});
+  projector_margin_px_ = 0;
+  if (!projector.has_distortion()) return pinhole;
+  // Where the DMD's border pixels send their light in the ideal pinhole of the same K (the
+  // border suffices for the radial and tangential terms of real lenses): the margin.
+  double overshoot = 0.0;
+  const auto add = [&](int u, int v) {
+    const Eigen::Vector2d p = projector.undistort_pixel(Eigen::Vector2d(u, v));
+    if (!p.allFinite() ||
+        (projector.project(Eigen::Vector3d((p.x() - projector.cx_px) / projector.fx_px,
+                                           (p.y() - projector.cy_px) / projector.fy_px, 1.0)) -
+         Eigen::Vector2d(u, v))
+                .norm() > 1e-3) {
+      throw std::invalid_argument(
+          "sim::Renderer: the projector's distortion does not invert at DMD pixel (" +
+          std::to_string(u) + ", " + std::to_string(v) + ")");
+    }
+    overshoot = std::max(
+        {overshoot, -p.x(), p.x() - (projector.width - 1), -p.y(), p.y() - (projector.height - 1)});
+  };
+  for (int u = 0; u < projector.width; ++u) {
+    add(u, 0);
+    add(u, projector.height - 1);
+  }
+  for (int v = 0; v < projector.height; ++v) {
+    add(0, v);
+    add(projector.width - 1, v);
+  }
+  const int margin = static_cast<int>(std::ceil(overshoot)) + 2;
+  if (margin > std::max(projector.width, projector.height) / 2) {
+    throw std::invalid_argument("sim::Renderer: the projector's distortion reaches " +
+                                std::to_string(margin) +
+                                " px beyond its pinhole image; not a lens this renderer supports");
+  }
+  projector_margin_px_ = margin;
+  pinhole.width += 2 * margin;
+  pinhole.height += 2 * margin;
+  pinhole.cx_px += margin;
+  pinhole.cy_px += margin;
+  return pinhole;
+}
+
 const Renderer::Truth& Renderer::truth() const {
   if (!truth_.valid) {
     // Same computation as set_view()'s, with the ground-truth arrays written too.
@@ -231,12 +306,14 @@ const Renderer::Truth& Renderer::truth() const {
       const std::size_t n = remap_.size();
       truth_camera_.depth_m.resize(n);
       truth_camera_.projector_row.resize(n);
+      truth_camera_.projector_column.resize(n);
       truth_camera_.object_index.resize(n);
       truth_camera_.code.resize(n);
       for (std::size_t o = 0; o < n; ++o) {
         const std::uint32_t j = remap_[o].nearest;
         truth_camera_.depth_m[o] = truth_.depth_m[j];
         truth_camera_.projector_row[o] = truth_.projector_row[j];
+        truth_camera_.projector_column[o] = truth_.projector_column[j];
         truth_camera_.object_index[o] = truth_.object_index[j];
         truth_camera_.code[o] = truth_.code[j];
       }
@@ -304,7 +381,9 @@ void Renderer::set_view(const std::vector<RenderObject>& objects) {
   std::vector<bool> moved(n, true);
   if (!full) {
     for (std::size_t o = 0; o < n; ++o) {
-      if (objects[o].mesh != last_mesh_[o]) full = true;
+      if (objects[o].mesh != last_mesh_[o] || objects[o].checkerboard != last_checkerboard_[o]) {
+        full = true;
+      }
       moved[o] = objects[o].albedo != last_albedo_[o] ||
                  objects[o].T_camera_object.matrix() != last_pose_[o];
     }
@@ -348,8 +427,10 @@ void Renderer::set_view(const std::vector<RenderObject>& objects) {
   last_mesh_.resize(n);
   last_pose_.resize(n);
   last_albedo_.resize(n);
+  last_checkerboard_.resize(n);
   for (std::size_t o = 0; o < n; ++o) {
     last_mesh_[o] = objects[o].mesh;
+    last_checkerboard_[o] = objects[o].checkerboard;
     last_pose_[o] = objects[o].T_camera_object.matrix();
     last_albedo_[o] = objects[o].albedo;
   }
@@ -375,6 +456,9 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
   triangle_object_.clear();
   triangle_albedo_dn_.clear();
   triangle_normal_dot_projector_.clear();
+  triangle_plane_offset_.clear();
+  object_checkerboard_.resize(objects.size());
+  object_T_object_camera_.resize(objects.size());
   camera_vertices_.resize(objects.size());
   projector_vertices_.resize(objects.size());
   new_camera_box_.resize(objects.size());
@@ -384,6 +468,13 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
       throw std::invalid_argument("sim::Renderer: object without mesh");
     const geometry::Mesh& mesh = *objects[o].mesh;
     const Eigen::Isometry3f T = objects[o].T_camera_object.cast<float>();
+    object_checkerboard_[o] = objects[o].checkerboard;
+    if (objects[o].checkerboard) {
+      if (const std::string why = objects[o].checkerboard->problem(); !why.empty()) {
+        throw std::invalid_argument("sim::Renderer: checkerboard: " + why);
+      }
+    }
+    object_T_object_camera_[o] = objects[o].T_camera_object.inverse();
     std::vector<Eigen::Vector3f>& camera = camera_vertices_[o];
     std::vector<Eigen::Vector3f>& projector = projector_vertices_[o];
     camera.resize(mesh.vertices.size());
@@ -399,6 +490,7 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
       triangle_albedo_dn_.push_back(kFullScaleDn * static_cast<float>(objects[o].albedo));
       triangle_normal_dot_projector_.push_back(
           normal_camera_.back().dot(projector_centre_camera_m_));
+      triangle_plane_offset_.push_back(normal_camera_.back().dot(a));
     }
     new_camera_box_[o] = screen_box(camera_view_, camera);
     new_shadow_box_[o] = screen_box(shadow_view_, projector);
@@ -424,6 +516,50 @@ void Renderer::rasterize_all(const std::vector<RenderObject>& objects, const Box
   }
 }
 
+float Renderer::textured_albedo(std::int32_t triangle, int x, int y, SubSamples* sub) const {
+  // The pixel's footprint on the triangle's plane: 4 x 4 rays through the pinhole pixel.
+  constexpr int kSide = 4;
+  static_assert(kSide * kSide == kSubSamples);
+  const auto o = static_cast<std::size_t>(triangle_object_[triangle]);
+  const Checkerboard& board = *object_checkerboard_[o];
+  const Eigen::Isometry3d& T_object_camera = object_T_object_camera_[o];
+  const Eigen::Vector3d n = normal_camera_[triangle].cast<double>();
+  const double offset = triangle_plane_offset_[triangle];
+  const Eigen::Matrix3d R = R_projector_camera_.cast<double>();
+  const Eigen::Vector3d t = t_projector_camera_m_.cast<double>();
+  double sum = 0;
+  for (int j = 0; j < kSide; ++j) {
+    for (int i = 0; i < kSide; ++i) {
+      const double dx = (i + 0.5) / kSide - 0.5, dy = (j + 0.5) / kSide - 0.5;
+      const Eigen::Vector3d ray((x + dx - camera_view_.cx_px) / camera_view_.fx_px,
+                                (y + dy - camera_view_.cy_px) / camera_view_.fy_px, 1.0);
+      const Eigen::Vector3d p_camera = ray * (offset / n.dot(ray));
+      const Eigen::Vector3d p_object = T_object_camera * p_camera;
+      const double albedo = board.albedo(p_object.x(), p_object.y());
+      sum += albedo;
+      if (sub == nullptr) continue;
+      const int s = j * kSide + i;
+      sub->albedo[s] = static_cast<std::uint8_t>(std::lround(255 * albedo));
+      sub->row_gray[s] = sub->column_gray[s] = 0;
+      const Eigen::Vector3d q = R * p_camera + t;
+      if (!(q.z() > config_.near_clip_m)) continue;
+      const Eigen::Vector2d uv = projector_.project(q);  // with the projector's distortion
+      if (!projector_.contains(uv)) continue;
+      const int row = row_code_[static_cast<std::size_t>(uv.y() + 0.5)];
+      const int column = column_code_[static_cast<std::size_t>(uv.x() + 0.5)];
+      if (row >= 0) {
+        sub->row_gray[s] = static_cast<std::uint16_t>(
+            kCoded | decode::binary_to_gray(static_cast<std::uint32_t>(row)));
+      }
+      if (column >= 0) {
+        sub->column_gray[s] = static_cast<std::uint16_t>(
+            kCoded | decode::binary_to_gray(static_cast<std::uint32_t>(column)));
+      }
+    }
+  }
+  return static_cast<float>(sum / kSubSamples);
+}
+
 template <bool kWithTruth>
 void Renderer::compute_row(int y, Truth* truth) {
   constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
@@ -437,6 +573,10 @@ void Renderer::compute_row(int y, Truth* truth) {
   float* base_out = base_dn_.data() + row_start;
   float* gain_out = gain_dn_.data() + row_start;
   std::uint16_t* gray_out = gray_.data() + row_start;
+  std::uint16_t* column_gray_out =
+      calibration_patterns_ ? column_gray_.data() + row_start : nullptr;
+  const std::int16_t* column_code = column_code_.data();
+  const bool calibration = calibration_patterns_;
   std::int16_t* cell_u_out = shadow_cell_u_.data() + row_start;
   std::int16_t* cell_v_out = shadow_cell_v_.data() + row_start;
   const Eigen::Vector3f* normals = normal_camera_.data();
@@ -457,14 +597,20 @@ void Renderer::compute_row(int y, Truth* truth) {
   const auto cx = static_cast<float>(projector_.cx_px), cy = static_cast<float>(projector_.cy_px);
   const auto u_max = static_cast<float>(projector_.width) - 0.5f;
   const auto v_max = static_cast<float>(projector_.height) - 0.5f;
+  // Projector distortion: project_row gives coordinates in the ideal pinhole widened by the
+  // margin (the shadow map's view), which the lens then maps to the DMD pixel that lights them.
+  const bool distorted = projector_.has_distortion();
+  const auto margin = static_cast<float>(projector_margin_px_);
+  const float ideal_cx = cx + margin, ideal_cy = cy + margin;
+  const float ideal_u_max = u_max + 2 * margin, ideal_v_max = v_max + 2 * margin;
   // q = R p + t with p = z (rx, ry, 1): R p = z (R.col(0) rx + R.col(1) ry + R.col(2)).
   const Eigen::Vector3f row_term = R_projector_camera_.col(1) * ray_y + R_projector_camera_.col(2);
   const Eigen::Vector3f column_term = R_projector_camera_.col(0);
   const Eigen::Vector3f t = t_projector_camera_m_;
 
   // Pass 1 (branch-free, vectorised): depth and projector coordinates of every pixel.
-  project_row(width, inv_depth, ray_x, column_term, row_term, t, near, fx, fy, cx, cy, ray_y,
-              projector_centre_camera_m_, row_z_.data(), row_qz_.data(), row_u_.data(),
+  project_row(width, inv_depth, ray_x, column_term, row_term, t, near, fx, fy, ideal_cx, ideal_cy,
+              ray_y, projector_centre_camera_m_, row_z_.data(), row_qz_.data(), row_u_.data(),
               row_v_.data(), row_inv_distance_.data());
   const float* inv_distance = row_inv_distance_.data();
   const float* z_row = row_z_.data();
@@ -475,16 +621,25 @@ void Renderer::compute_row(int y, Truth* truth) {
   for (int x = 0; x < width; ++x) {
     const std::int32_t id = ids[x];
     gray_out[x] = 0;
+    if (calibration) {
+      column_gray_out[x] = 0;
+      is_sub_sampled_[row_start + x] = 0;
+    }
     cell_u_out[x] = cell_v_out[x] = -1;
     if constexpr (kWithTruth) {
       truth->projector_row[row_start + x] = kNaN;
+      truth->projector_column[row_start + x] = kNaN;
       truth->code[row_start + x] = -1;
       truth->depth_m[row_start + x] = id < 0 ? 0.0f : z_row[x];
       truth->object_index[row_start + x] = id < 0 ? -1 : triangle_object_[id];
     }
     base_out[x] = gain_out[x] = 0.0f;
     if (id < 0) continue;
-    const float albedo = albedo_dn[id];
+    const bool textured =
+        object_checkerboard_[static_cast<std::size_t>(triangle_object_[id])] != nullptr;
+    SubSamples* sub = textured && calibration ? &sub_samples_[row_start + x] : nullptr;
+    if (calibration) is_sub_sampled_[row_start + x] = sub != nullptr;
+    const float albedo = textured ? kFullScaleDn * textured_albedo(id, x, y, sub) : albedo_dn[id];
     base_out[x] = albedo * ambient;
     // cos(normal, direction to the projector): n.(c - p) with p = z ray, n.c per triangle.
     const Eigen::Vector3f& n = normals[id];
@@ -492,12 +647,23 @@ void Renderer::compute_row(int y, Truth* truth) {
     float facing = normal_dot_projector[id] - z_row[x] * n_ray;
     if (n_ray > 0) facing = -facing;  // back face, drawn with culling off
     if (!(facing > 0)) continue;      // turned away from the projector
-    const float u = u_row[x], v = v_row[x];
+    const float u_ideal = u_row[x], v_ideal = v_row[x];  // in the (widened) ideal pinhole
+    float u = u_ideal, v = v_ideal;                      // on the DMD
+    if (distorted) {
+      if (!(qz_row[x] > near) ||
+          !(u_ideal > -0.5f && u_ideal < ideal_u_max && v_ideal > -0.5f && v_ideal < ideal_v_max)) {
+        continue;  // behind the projector or outside what its lens can reach
+      }
+      const Eigen::Vector2d xy =
+          projector_.distort(Eigen::Vector2d((u_ideal - ideal_cx) / fx, (v_ideal - ideal_cy) / fy));
+      u = fx * static_cast<float>(xy.x()) + cx;
+      v = fy * static_cast<float>(xy.y()) + cy;
+    }
     bool lit = u > -0.5f && u < u_max && v > -0.5f && v < v_max;  // also false behind it
     const int code = lit ? row_code[static_cast<int>(v + 0.5f)] : -1;
-    if (code >= 0) {
-      const auto cell_u = static_cast<std::size_t>((u + 0.5f) * scale);
-      const auto cell_v = static_cast<std::size_t>((v + 0.5f) * scale);
+    if (lit && (code >= 0 || calibration)) {
+      const auto cell_u = static_cast<std::size_t>((u_ideal + 0.5f) * scale);
+      const auto cell_v = static_cast<std::size_t>((v_ideal + 0.5f) * scale);
       const std::size_t j = cell_v * shadow_width + cell_u;
       cell_u_out[x] = static_cast<std::int16_t>(cell_u);
       cell_v_out[x] = static_cast<std::int16_t>(cell_v);
@@ -505,16 +671,30 @@ void Renderer::compute_row(int y, Truth* truth) {
       // Something nearer to the projector covers this point: projector shadow.
       lit = shadow_id[j] == id || !(w_seen > 0) || qz_row[x] * w_seen <= 1.0f + bias * w_seen;
     }
-    if (!lit || code < 0) continue;  // shadowed, outside the projector or an uncoded (dark) row
+    // Shadowed, outside the projector, or (row codes only) an uncoded (dark) row.
+    if (!lit || (code < 0 && !calibration)) continue;
     float irradiance = projector_level * facing * inv_distance[x];
     if (falloff2 > 0) irradiance *= falloff2 * inv_distance[x] * inv_distance[x];
     gain_out[x] = albedo * irradiance;
+    if (sub != nullptr) gain_out[x] = kFullScaleDn * irradiance;  // albedo per sub-sample
     if constexpr (kWithTruth) {
-      truth->projector_row[row_start + x] = v;
-      truth->code[row_start + x] = static_cast<std::int16_t>(code);
+      truth->projector_column[row_start + x] = u;
+      if (code >= 0) {
+        truth->projector_row[row_start + x] = v;
+        truth->code[row_start + x] = static_cast<std::int16_t>(code);
+      }
     }
-    gray_out[x] =
-        static_cast<std::uint16_t>(decode::binary_to_gray(static_cast<std::uint32_t>(code)));
+    if (code >= 0) {
+      gray_out[x] = static_cast<std::uint16_t>(
+          kCoded | decode::binary_to_gray(static_cast<std::uint32_t>(code)));
+    }
+    if (calibration) {
+      const int column = column_code[static_cast<int>(u + 0.5f)];
+      if (column >= 0) {
+        column_gray_out[x] = static_cast<std::uint16_t>(
+            kCoded | decode::binary_to_gray(static_cast<std::uint32_t>(column)));
+      }
+    }
   }
 }
 
@@ -546,27 +726,85 @@ void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) 
 }
 
 void Renderer::shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out) const {
-  const int shift = config_.geometry.layout.bit_count - 1 - bit_index;  // Eq. 1: k = 0 is the MSB
-  const unsigned flip = positive ? 0u : 1u;
+  shade(FramePattern{ProjectorFrame::kRowBit, bit_index, positive}, noise_key, out);
+}
+
+void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out) const {
   const float* base = base_dn_.data();
   const float* gain = gain_dn_.data();
-  const std::uint16_t* gray = gray_.data();
+  if (pattern.frame == ProjectorFrame::kBlack) {
+    quantise(
+        noise_key, [&](std::size_t i) { return base[i]; }, out);
+    return;
+  }
+  if (!calibration_patterns_ && pattern.frame != ProjectorFrame::kRowBit) {
+    throw std::logic_error(
+        "sim::Renderer: white and column-code frames need RendererConfig::column_layout");
+  }
+  // Sub-sampled pixels (a printed target, calibration patterns): the pattern's light
+  // integrated over the pixel, sub-sample by sub-sample with its own albedo.
+  const std::uint8_t* sub_sampled = is_sub_sampled_.data();
+  const SubSamples* subs = sub_samples_.data();
+  constexpr float kSubScale = 1.0f / (kSubSamples * kFullScaleDn);
+  if (pattern.frame == ProjectorFrame::kWhite) {
+    quantise(
+        noise_key,
+        [&](std::size_t i) {
+          if (!sub_sampled[i]) return base[i] + gain[i];
+          int sum = 0;
+          for (int s = 0; s < kSubSamples; ++s) {
+            sum += subs[i].albedo[s] * ((subs[i].row_gray[s] | subs[i].column_gray[s]) >> 15);
+          }
+          return base[i] + gain[i] * kSubScale * static_cast<float>(sum);
+        },
+        out);
+    return;
+  }
+  const bool columns = pattern.frame == ProjectorFrame::kColumnBit;
+  const int bit_count =
+      columns ? config_.column_layout->bit_count : config_.geometry.layout.bit_count;
+  if (pattern.bit_index < 0 || pattern.bit_index >= bit_count) {
+    throw std::invalid_argument("sim::Renderer: bit " + std::to_string(pattern.bit_index) +
+                                " outside the code's " + std::to_string(bit_count) + " bits");
+  }
+  const int shift = bit_count - 1 - pattern.bit_index;  // Eq. 1: k = 0 is the MSB
+  const unsigned flip = pattern.positive ? 0u : 1u;
+  const std::uint16_t* gray = columns ? column_gray_.data() : gray_.data();
+  const auto bit_of = [shift, flip](unsigned g) {
+    // Uncoded pixels (no kCoded flag) are dark in both polarities.
+    return (((g >> shift) & 1u) ^ flip) & (g >> 15);
+  };
+  if (!calibration_patterns_) {
+    quantise(
+        noise_key,
+        [&](std::size_t i) { return base[i] + gain[i] * static_cast<float>(bit_of(gray[i])); },
+        out);
+    return;
+  }
   quantise(
       noise_key,
       [&](std::size_t i) {
-        const unsigned bit = ((static_cast<unsigned>(gray[i]) >> shift) & 1u) ^ flip;
-        return base[i] + gain[i] * static_cast<float>(bit);
+        if (!sub_sampled[i]) return base[i] + gain[i] * static_cast<float>(bit_of(gray[i]));
+        const std::uint16_t* sub_gray = columns ? subs[i].column_gray : subs[i].row_gray;
+        int sum = 0;
+        for (int s = 0; s < kSubSamples; ++s) sum += subs[i].albedo[s] * bit_of(sub_gray[s]);
+        return base[i] + gain[i] * kSubScale * static_cast<float>(sum);
       },
       out);
 }
 
 void Renderer::accumulate(int bit_index, bool positive, float weight,
                           std::vector<float>& sum) const {
+  if (calibration_patterns_) {
+    // Sub-sampled pixels keep their albedo per sub-sample, which this sum does not read.
+    throw std::logic_error("sim::Renderer: motion blur is not rendered with calibration patterns");
+  }
   sum.resize(base_dn_.size(), 0.0f);
   const int shift = config_.geometry.layout.bit_count - 1 - bit_index;
   const unsigned flip = positive ? 0u : 1u;
   for (std::size_t i = 0; i < sum.size(); ++i) {
-    const unsigned bit = ((static_cast<unsigned>(gray_[i]) >> shift) & 1u) ^ flip;
+    const auto g = static_cast<unsigned>(gray_[i]);
+    const unsigned bit = (((g >> shift) & 1u) ^ flip) & (g >> 15);
     sum[i] += weight * (base_dn_[i] + gain_dn_[i] * static_cast<float>(bit));
   }
 }

@@ -168,7 +168,11 @@ class SimScene final : public runtime::Component {
              ParamSpec::string("calibration_file", "",
                                "sensor geometry YAML the renderer uses (decode's format, "
                                "docs/decode.md; camera distortion rendered); empty: the "
-                               "paper's sensor, default_sensor_geometry()")},
+                               "paper's sensor, default_sensor_geometry()"),
+             ParamSpec::string("true_calibration_file", "",
+                               "when set, the renderer uses this sensor geometry instead of "
+                               "calibration_file: the simulator's truth, against which a "
+                               "recovered calibration given to decode is tested (issue 14)")},
         .publishes =
             {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern", keep_last_4),
              runtime::port<msgs::avs_msgs::GroundTruth>("ground_truth", "/sim/ground_truth"),
@@ -284,7 +288,9 @@ class SimScene final : public runtime::Component {
       c.motion_blur_samples = static_cast<int>(n);
     }
     if (const double rate = ctx.param<double>("frame_rate_hz"); rate > 0) c.frame_rate_hz = rate;
-    if (const auto calibration = ctx.param<std::string>("calibration_file"); !calibration.empty()) {
+    std::string calibration = ctx.param<std::string>("true_calibration_file");
+    if (calibration.empty()) calibration = ctx.param<std::string>("calibration_file");
+    if (!calibration.empty()) {
       c.renderer.geometry = decode::load_sensor_geometry_yaml(calibration);
       log().info("sensor geometry from ", calibration);
     }

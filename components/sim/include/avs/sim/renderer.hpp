@@ -10,22 +10,31 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Geometry>
 
 #include "avs/decode/sensor_geometry.hpp"
 #include "avs/geometry/mesh.hpp"
+#include "avs/sim/checkerboard.hpp"
 #include "avs/sim/rasterizer.hpp"
 
 namespace avs::sim {
 
 struct RendererConfig {
-  /// Camera and projector lenses, their relative pose and the code layout: the decoder's
-  /// defaults (Tables 1-2, sections 4.1 and 4.3; see decode/sensor_geometry.hpp). The camera's
-  /// lens distortion is rendered (the ideal pinhole image, remapped bilinearly to the camera's
-  /// pixels before noise); the projector's is not yet: the constructor throws for it.
+  /// Camera and projector lenses, their relative pose (any R, t) and the code layout of the
+  /// row codes: the decoder's defaults (Tables 1-2, sections 4.1 and 4.3; see
+  /// decode/sensor_geometry.hpp). Both lenses' distortion is rendered: the camera's as the
+  /// ideal pinhole image remapped bilinearly to the camera's pixels before noise, the
+  /// projector's by looking each lit point's ideal projector coordinates up in the distorted
+  /// DMD image (the pattern pixel that really lights it).
   decode::SensorGeometry geometry = decode::default_sensor_geometry();
+  /// Calibration patterns (issue 14): when set, the renderer also shows Gray codes over the
+  /// projector's columns with this layout (its "rows" are DMD columns), all-white frames, and
+  /// lights and shadow-tests every DMD row, not only the coded rows of `geometry.layout`.
+  /// Unset (the 500 Hz simulator): row codes only; white and column frames throw.
+  std::optional<decode::CodeLayout> column_layout;
   /// Light levels as fractions of the 8-bit full scale (255 DN), before albedo. Not given
   /// in the paper (our choice): dim room light, a bright projector (150 lm, Table 1).
   double ambient_level = 0.10;
@@ -48,11 +57,25 @@ struct RendererConfig {
   double near_clip_m = 0.05;
 };
 
+/// What the projector shows in one frame: a bit of the row code (Eq. 1, geometry.layout), a
+/// bit of the column code (column_layout), everything on, or nothing.
+enum class ProjectorFrame : std::uint8_t { kRowBit, kColumnBit, kWhite, kBlack };
+
+struct FramePattern {
+  ProjectorFrame frame = ProjectorFrame::kRowBit;
+  int bit_index = 0;  ///< 0 = MSB; row and column bits only
+  bool positive = true;
+};
+
 /// One mesh placed in the camera frame (the renderer does not own the mesh).
 struct RenderObject {
   const geometry::Mesh* mesh = nullptr;
   Eigen::Isometry3d T_camera_object = Eigen::Isometry3d::Identity();
   double albedo = 0.7;
+  /// When set, the object's albedo is this printed pattern (object frame = board frame,
+  /// usually on make_checkerboard_mesh()), averaged over 4 x 4 points per camera pixel;
+  /// `albedo` is then unused. The renderer does not own it.
+  const Checkerboard* checkerboard = nullptr;
 };
 
 /// 8-bit mono image, row-major.
@@ -82,9 +105,13 @@ class Renderer {
   /// Frame with bit `bit_index` (0 = MSB) of the pattern, positive or negative, noise drawn
   /// from (noise_seed, noise_key): the same key gives the same image.
   void shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out) const;
+  /// Any frame (row or column bit, white, black); column and white frames need
+  /// RendererConfig::column_layout (std::logic_error otherwise).
+  void shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out) const;
 
   /// Motion blur: adds weight x the noise-free intensity (DN) of the current view to `sum`
-  /// (width*height floats); finish() adds noise and quantises.
+  /// (width*height floats); finish() adds noise and quantises. Row codes only: throws
+  /// std::logic_error with calibration patterns (RendererConfig::column_layout).
   void accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum) const;
   void finish(const std::vector<float>& sum, std::uint64_t noise_key, MonoImage& out) const;
 
@@ -97,6 +124,10 @@ class Renderer {
   /// Continuous projector row (pixel centres at integers) of the visible surface point when
   /// the projector lights it (inside its coded rows, not shadowed, facing it); NaN otherwise.
   const std::vector<float>& projector_row() const { return truth().projector_row; }
+  /// Continuous projector column of the visible surface point when the projector lights it
+  /// (on the DMD, not shadowed, facing it; with column_layout: any DMD row, without: coded rows
+  /// only); NaN otherwise.
+  const std::vector<float>& projector_column() const { return truth().projector_column; }
   /// Code whose rows light the pixel (Eq. 1 layout), -1 when no coded row does.
   const std::vector<std::int16_t>& code() const { return truth().code; }
 
@@ -112,7 +143,7 @@ class Renderer {
   bool row_reads_shadow_cells(int y, const Box& cells) const;
   struct Truth {
     bool valid = false;
-    std::vector<float> depth_m, projector_row;
+    std::vector<float> depth_m, projector_row, projector_column;
     std::vector<std::int16_t> object_index, code;
   };
   template <bool kWithTruth>
@@ -121,13 +152,19 @@ class Renderer {
   /// The camera without distortion, widened by a margin when the camera has distortion, and
   /// remap_ for it (empty without distortion).
   geometry::CameraModel make_pinhole_and_remap(const geometry::CameraModel& camera);
+  /// The projector without distortion, widened by the margin its distortion needs (the ideal
+  /// view the shadow map is rasterised in); sets projector_margin_px_.
+  geometry::CameraModel make_projector_pinhole(const geometry::CameraModel& projector);
   template <typename ValueFn>
   void quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) const;
 
   RendererConfig config_;
   PinholeView camera_view_, shadow_view_;
   geometry::CameraModel projector_;
-  std::vector<std::int16_t> row_code_;   ///< code of each projector row, -1 if uncoded
+  double projector_margin_px_ = 0;      ///< ideal projector view = DMD + this margin on each side
+  bool calibration_patterns_ = false;   ///< column_layout set: every DMD row lit and tested
+  std::vector<std::int16_t> row_code_;  ///< code of each projector row, -1 if uncoded
+  std::vector<std::int16_t> column_code_;  ///< code of each projector column (column_layout)
   std::vector<std::int8_t> noise_bank_;  ///< N(0, 1) samples x 32, drawn once from noise_seed
   Eigen::Matrix3f R_projector_camera_;
   Eigen::Vector3f t_projector_camera_m_, projector_centre_camera_m_;
@@ -140,19 +177,41 @@ class Renderer {
   std::vector<std::int16_t> triangle_object_;
   std::vector<float> triangle_albedo_dn_;             ///< 255 x albedo of the triangle's object
   std::vector<float> triangle_normal_dot_projector_;  ///< n . projector centre (camera frame)
+  std::vector<float> triangle_plane_offset_;          ///< n . (a vertex), camera frame
+  /// Per object of the current view: its printed pattern (or null) and T_object_camera.
+  std::vector<const Checkerboard*> object_checkerboard_;
+  std::vector<Eigen::Isometry3d> object_T_object_camera_;
+  /// A textured pixel's 4 x 4 sub-samples (calibration patterns only): each one's albedo
+  /// (x 255) and the Gray codes (with kCoded) of the row and column that light it, so that a
+  /// frame integrates the pattern over the pixel as a sensor does (stripe edges then blur
+  /// without the bias that point-sampled stripes get from the lens distortion remap).
+  static constexpr int kSubSamples = 16;
+  struct SubSamples {
+    std::uint16_t row_gray[kSubSamples];
+    std::uint16_t column_gray[kSubSamples];
+    std::uint8_t albedo[kSubSamples];
+  };
+  /// Albedo (0..1) of a textured triangle's surface averaged over pinhole pixel (x, y); fills
+  /// `sub` when given.
+  float textured_albedo(std::int32_t triangle, int x, int y, SubSamples* sub) const;
+  std::vector<SubSamples> sub_samples_;       ///< per pinhole pixel (calibration patterns only)
+  std::vector<std::uint8_t> is_sub_sampled_;  ///< per pinhole pixel: sub_samples_ is valid
   std::vector<std::vector<Eigen::Vector3f>> camera_vertices_, projector_vertices_;  ///< per object
   // State of the previous set_view() for the incremental pass.
   bool have_last_ = false;
   std::vector<const geometry::Mesh*> last_mesh_;
   std::vector<Eigen::Matrix4d> last_pose_;
   std::vector<double> last_albedo_;
+  std::vector<const Checkerboard*> last_checkerboard_;
   std::vector<Box> camera_box_, shadow_box_;          ///< per object, previous view
   std::vector<Box> new_camera_box_, new_shadow_box_;  ///< per object, current view
   /// Per camera pixel: the shadow-map cell (column, row) its last shadow test read; -1: none.
   std::vector<std::int16_t> shadow_cell_u_, shadow_cell_v_;
   // Per pixel, for shading: intensity = base + gain * bit.
   std::vector<float> base_dn_, gain_dn_;
-  std::vector<std::uint16_t> gray_;
+  /// Gray code of the row (column) code lighting each pixel, with kCoded set; 0 where no
+  /// coded row (column) lights it.
+  std::vector<std::uint16_t> gray_, column_gray_;
   mutable Truth truth_;  ///< filled lazily by truth()
   /// With lens distortion: per camera pixel, the four pinhole pixels (camera_view_) around the
   /// ideal point it sees, bilinear weights, and the nearest of them (for the ground truth).

@@ -1,0 +1,52 @@
+// Checks the YAML file formats of avs share (calibration files, capture indexes, board-pose
+// files): an error naming the node's file, line and column, unknown keys, number lists.
+// Written once (issue 14); include only where yaml-cpp is already used.
+#pragma once
+
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "avs/runtime/text.hpp"
+
+namespace avs::runtime {
+
+/// Throws std::runtime_error "source:line:column: what".
+[[noreturn]] inline void yaml_fail(const std::string& source, const YAML::Node& node,
+                                   const std::string& what) {
+  throw std::runtime_error(yaml_location(source, node.Mark()) + ": " + what);
+}
+
+/// `node` must be a map whose keys are all in `allowed`; `section` names it in errors.
+inline void yaml_check_keys(const std::string& source, const YAML::Node& node,
+                            const std::set<std::string>& allowed, const std::string& section) {
+  if (!node.IsMap()) yaml_fail(source, node, section + " must be a map");
+  for (const auto& entry : node) {
+    const auto key = entry.first.as<std::string>();
+    if (!allowed.count(key)) {
+      yaml_fail(source, entry.first, "unknown key '" + key + "' in " + section);
+    }
+  }
+}
+
+/// `node` must be a list of exactly `size` numbers; `key` names it in errors.
+inline std::vector<double> yaml_numbers(const std::string& source, const YAML::Node& node,
+                                        std::size_t size, const std::string& key) {
+  if (!node.IsSequence() || node.size() != size) {
+    yaml_fail(source, node, "'" + key + "' must be a list of " + std::to_string(size) + " numbers");
+  }
+  std::vector<double> values;
+  for (const auto& item : node) {
+    try {
+      values.push_back(item.as<double>());
+    } catch (const YAML::Exception&) {
+      yaml_fail(source, item, "'" + key + "' must hold numbers");
+    }
+  }
+  return values;
+}
+
+}  // namespace avs::runtime

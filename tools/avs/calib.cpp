@@ -1,0 +1,342 @@
+// avs calib capture | solve | bench: projector-camera calibration (issue 14,
+// docs/calibration.md). The work is done by components/calib (avs_calib_core, avs_calib_io);
+// these are its command-line wrappers. Built with OpenCV only; without it `avs calib` says so.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+
+#if __has_include("avs/calib/capture_folder.hpp")
+#include "avs/calib/bench.hpp"
+#include "avs/calib/capture_folder.hpp"
+#include "avs/calib/solve.hpp"
+#include "avs/decode/calibration_yaml.hpp"
+#define AVS_HAVE_CALIB 1
+#endif
+
+namespace avs::cli {
+namespace {
+
+struct CaptureOptions {
+  std::string out;
+  std::string source = "sim";
+  std::string poses;
+  int generate = 0;
+  double near_m = 0.5;
+  double far_m = 2.0;
+  double max_tilt_deg = 30;
+  unsigned long seed = 14;
+  std::string calibration;
+  double noise_dn = 2.0;
+  int pixels_per_code = 4;
+};
+
+struct SolveOptions {
+  std::string capture;
+  std::string out;
+  std::string report;
+  int min_views = 6;
+  double max_camera_rms_px = 0.5;
+  double max_projector_rms_px = 1.0;
+  double min_coverage = 0.5;
+};
+
+struct BenchOptions {
+  bool json = false;
+  int views = 16;
+  unsigned long seed = 14;
+  double noise_dn = 2.0;
+};
+
+#ifdef AVS_HAVE_CALIB
+
+namespace fs = std::filesystem;
+
+int run_capture(const CaptureOptions& o) {
+  if (o.source != "sim") {
+    std::cerr << "avs calib capture: source '" << o.source
+              << "' is NOT IMPLEMENTED yet (issue 14: bag and camera sources); only 'sim'\n";
+    return 2;
+  }
+  if (o.poses.empty() == (o.generate == 0)) {
+    std::cerr << "avs calib capture: give either --poses FILE or --generate N\n";
+    return 2;
+  }
+  sim::RendererConfig renderer;
+  renderer.geometry = o.calibration.empty() ? calib::bench_truth_geometry()
+                                            : decode::load_sensor_geometry_yaml(o.calibration);
+  renderer.noise_sigma_dn = o.noise_dn;
+  renderer.noise_seed = o.seed;
+  calib::BoardPoses poses;
+  if (!o.poses.empty()) {
+    poses = calib::load_board_poses_yaml(o.poses);
+  } else {
+    poses.T_camera_board = calib::generate_board_poses(renderer.geometry, poses.board, o.generate,
+                                                       o.near_m, o.far_m, o.max_tilt_deg, o.seed);
+  }
+  calib::SimCapture capture(renderer, poses.board, o.pixels_per_code);
+  calib::CaptureIndex index{capture.info(), {}};
+  const fs::path dir(o.out);
+  std::vector<Eigen::Vector2d> corners;
+  int found = 0;
+  const std::size_t n = poses.T_camera_board.size();
+  for (std::size_t v = 0; v < n; ++v) {
+    char name[32];
+    std::snprintf(name, sizeof name, "pose_%03zu", v);
+    const Eigen::Isometry3d& T = poses.T_camera_board[v];
+    const calib::PoseVisibility seen =
+        calib::pose_visibility(renderer.geometry, poses.board, T, 0.0);
+    const calib::BoardView view = capture.render(T, static_cast<int>(v), name);
+    calib::write_view_frames(dir, view, capture.info());
+    index.views.push_back({view.name, view.T_camera_board_truth});
+    calib::write_capture_index(dir, index);
+    const std::vector<Eigen::Vector2d> c = calib::find_board_corners(view.frames[0], poses.board);
+    found += c.empty() ? 0 : 1;
+    corners.insert(corners.end(), c.begin(), c.end());
+    std::printf(
+        "pose %zu/%zu %s: z %.2f m, corners in view %.0f %% camera / %.0f %% projector, "
+        "%s\n",
+        v + 1, n, name, T.translation().z(), 100 * seen.camera, 100 * seen.projector,
+        c.empty() ? "board NOT found in the white frame"
+                  : ("board found, " + std::to_string(c.size()) + " corners").c_str());
+    std::fflush(stdout);
+  }
+  // Coverage of the camera image by the corners found (the check `avs calib solve` makes).
+  bool reached[4][4] = {};
+  for (const Eigen::Vector2d& p : corners) {
+    const int i = std::clamp(static_cast<int>(p.x() * 4 / capture.info().camera_width), 0, 3);
+    const int j = std::clamp(static_cast<int>(p.y() * 4 / capture.info().camera_height), 0, 3);
+    reached[j][i] = true;
+  }
+  int cells = 0;
+  for (const auto& row : reached) cells += static_cast<int>(std::count(row, row + 4, true));
+  std::printf("captured %zu poses to %s: board found in %d, camera coverage %d of 16 grid cells\n",
+              n, dir.string().c_str(), found, cells);
+  const calib::SolveConfig defaults;
+  if (found < defaults.min_views || cells < defaults.min_coverage * 16) {
+    std::printf(
+        "WARNING: too little for a calibration (solve needs %d views with the board and "
+        "%.0f %% coverage): add poses%s\n",
+        defaults.min_views, 100 * defaults.min_coverage,
+        cells < defaults.min_coverage * 16 ? " nearer the image corners" : "");
+    return 3;
+  }
+  return 0;
+}
+
+void print_truth_errors(const decode::SensorGeometry& t, const decode::SensorGeometry& e) {
+  std::printf(
+      "against the simulator's truth: camera f %+.3f / %+.3f %%, c %+.2f / %+.2f px; "
+      "projector f %+.3f / %+.3f %%, c %+.2f / %+.2f px; t %.3f mm off\n",
+      100 * (e.camera.fx_px / t.camera.fx_px - 1), 100 * (e.camera.fy_px / t.camera.fy_px - 1),
+      e.camera.cx_px - t.camera.cx_px, e.camera.cy_px - t.camera.cy_px,
+      100 * (e.projector.fx_px / t.projector.fx_px - 1),
+      100 * (e.projector.fy_px / t.projector.fy_px - 1), e.projector.cx_px - t.projector.cx_px,
+      e.projector.cy_px - t.projector.cy_px,
+      1000 * (e.t_projector_camera_m - t.t_projector_camera_m).norm());
+}
+
+int run_solve(const SolveOptions& o) {
+  const fs::path dir(o.capture);
+  const calib::CaptureIndex index = calib::read_capture_index(dir);
+  std::vector<calib::ViewObservation> observations;
+  for (std::size_t v = 0; v < index.views.size(); ++v) {
+    const calib::BoardView view = calib::read_view(dir, index.views[v], index.info);
+    observations.push_back(calib::observe_view(view, index.info));
+    const calib::ViewObservation& obs = observations.back();
+    std::printf("view %zu/%zu %s: %s\n", v + 1, index.views.size(), obs.name.c_str(),
+                obs.board_found ? (std::to_string(obs.corners_with_projector()) + " of " +
+                                   std::to_string(obs.corners.size()) + " corners with codes")
+                                      .c_str()
+                                : obs.problem.c_str());
+    std::fflush(stdout);
+  }
+  calib::SolveConfig config;
+  config.min_views = o.min_views;
+  config.max_camera_rms_px = o.max_camera_rms_px;
+  config.max_projector_rms_px = o.max_projector_rms_px;
+  config.min_coverage = o.min_coverage;
+  const calib::CalibrationResult result =
+      calib::solve_calibration(index.info, observations, config);
+  const std::string summary = calib::summary_text(result);
+  std::cout << summary;
+  if (index.info.truth && result.views_used >= 3)
+    print_truth_errors(*index.info.truth, result.geometry);
+  const fs::path report =
+      o.report.empty() ? fs::path(o.out).parent_path() / "calibration_report" : fs::path(o.report);
+  fs::create_directories(report);
+  std::ofstream(report / "summary.txt") << summary;
+  std::ofstream views(report / "view_errors.csv");
+  views << "view,used,corners,camera_rms_px,projector_rms_px,why_not\n";
+  for (const calib::ViewReport& v : result.views) {
+    views << v.name << ',' << (v.used ? 1 : 0) << ',' << v.corners << ',' << v.camera_rms_px << ','
+          << v.projector_rms_px << ",\"" << v.why_not << "\"\n";
+  }
+  if (result.views_used > 0) {
+    decode::write_png_gray8((report / "coverage_camera.png").string(),
+                            calib::coverage_image(index.info, observations, result, false));
+    decode::write_png_gray8((report / "coverage_projector.png").string(),
+                            calib::coverage_image(index.info, observations, result, true));
+  }
+  std::printf("report (summary.txt, view_errors.csv, coverage_*.png) in %s\n",
+              report.string().c_str());
+  if (!result.accepted) {
+    std::cerr << "avs calib solve: calibration refused, " << o.out << " not written:\n";
+    for (const std::string& why : result.refusals) std::cerr << "  " << why << '\n';
+    return 1;
+  }
+  if (!fs::path(o.out).parent_path().empty()) fs::create_directories(fs::path(o.out).parent_path());
+  std::ofstream file(o.out);
+  file << "# Calibration from avs calib solve " << o.capture << " (" << result.views_used
+       << " views, reprojection RMS camera " << result.camera_rms_px << " px, projector "
+       << result.projector_rms_px << " px)\n"
+       << decode::sensor_geometry_to_yaml(result.geometry);
+  if (!file) {
+    std::cerr << "avs calib solve: cannot write " << o.out << '\n';
+    return 1;
+  }
+  // Read back through the loader that decode, tracking and matching use.
+  decode::load_sensor_geometry_yaml(o.out);
+  std::printf("wrote %s (load it with --calibration or a component's calibration_file)\n",
+              o.out.c_str());
+  return 0;
+}
+
+int run_bench(const BenchOptions& o) {
+  calib::BenchConfig config;
+  config.views = o.views;
+  config.seed = o.seed;
+  config.noise_sigma_dn = o.noise_dn;
+  const calib::BenchResult r = calib::run_calibration_bench(config, o.json ? nullptr : stdout);
+  const calib::CalibrationResult& c = r.calibration;
+  if (o.json) {
+    std::printf(
+        "{\"accepted\": %s, \"views\": %d, \"views_used\": %d, \"focal_error_pct\": %.6g, "
+        "\"principal_point_error_px\": %.6g, \"distortion_error_px\": %.6g, "
+        "\"baseline_error_mm\": %.6g, \"rotation_error_deg\": %.6g, \"reprojection_rms_px\": "
+        "%.6g, \"camera_reprojection_rms_px\": %.6g, \"projector_reprojection_rms_px\": %.6g, "
+        "\"plane_rms_true_mm\": %.6g, \"plane_rms_recovered_mm\": %.6g, \"plane_rms_ratio\": "
+        "%.6g}\n",
+        c.accepted ? "true" : "false", o.views, c.views_used, r.focal_error_pct,
+        r.principal_point_error_px, r.distortion_error_px, r.baseline_error_mm,
+        r.rotation_error_deg, c.stereo_rms_px, c.camera_rms_px, c.projector_rms_px,
+        r.plane_rms_true_mm, r.plane_rms_recovered_mm, r.plane_rms_ratio);
+  } else {
+    std::cout << calib::summary_text(c);
+    std::printf(
+        "focal error %.3f %%, principal point %.2f px, distortion %.2f px, baseline %.3f "
+        "mm, rotation %.4f deg, plane depth RMS %.2f / %.2f mm = %.3f\n",
+        r.focal_error_pct, r.principal_point_error_px, r.distortion_error_px, r.baseline_error_mm,
+        r.rotation_error_deg, r.plane_rms_recovered_mm, r.plane_rms_true_mm, r.plane_rms_ratio);
+  }
+  return c.accepted ? 0 : 1;
+}
+
+template <typename Fn>
+void guarded(const char* name, Fn run) {
+  try {
+    exit_status() = run();
+  } catch (const std::exception& e) {
+    std::cerr << "avs calib " << name << ": " << e.what() << '\n';
+    exit_status() = 1;
+  }
+}
+
+#else
+
+template <typename Fn>
+void guarded(const char* name, Fn) {
+  std::cerr << "avs calib " << name
+            << ": NOT AVAILABLE: this avs was built without OpenCV (calib3d); install "
+               "libopencv-dev (bash tools/run.sh test does) and rebuild\n";
+  exit_status() = 1;
+}
+int run_capture(const CaptureOptions&) {
+  return 1;
+}
+int run_solve(const SolveOptions&) {
+  return 1;
+}
+int run_bench(const BenchOptions&) {
+  return 1;
+}
+
+#endif
+
+void add_calib_command(Command& app) {
+  auto* calib = app.add_subcommand(
+      "calib", "Projector-camera calibration: capture board views, solve, check (issue 14)");
+  calib->require_subcommand(1);
+
+  static CaptureOptions c;
+  auto* capture = calib->add_subcommand(
+      "capture",
+      "Capture board views (white, black, column and row Gray codes, positive and negative) "
+      "into a capture folder (PNG per frame + index.yaml); source: the simulator");
+  capture->add_option("--out", c.out, "capture folder (created)")->required();
+  capture->add_option("--source", c.source, "sim (bag and camera: not implemented yet)")
+      ->capture_default_str();
+  capture->add_option("--poses", c.poses, "board-pose YAML (board and a list of poses)")
+      ->check_existing_file();
+  capture->add_option("--generate", c.generate, "or: a seeded spread of N board poses");
+  capture->add_option("--near", c.near_m, "nearest board distance for --generate, m")
+      ->capture_default_str();
+  capture->add_option("--far", c.far_m, "farthest board distance for --generate, m")
+      ->capture_default_str();
+  capture->add_option("--max-tilt", c.max_tilt_deg, "board tilt for --generate, deg")
+      ->capture_default_str();
+  capture->add_option("--seed", c.seed, "poses and sensor noise seed")->capture_default_str();
+  capture
+      ->add_option("--calibration", c.calibration,
+                   "the simulated rig's true calibration (default: the bench's sensor, "
+                   "distortion on both lenses)")
+      ->check_existing_file();
+  capture->add_option("--noise", c.noise_dn, "sensor noise sigma, DN")->capture_default_str();
+  capture->add_option("--pixels-per-code", c.pixels_per_code, "DMD pixels per code stripe")
+      ->capture_default_str();
+  capture->callback([] { guarded("capture", [] { return run_capture(c); }); });
+
+  static SolveOptions s;
+  auto* solve = calib->add_subcommand(
+      "solve",
+      "Calibrate from a capture folder: corners, projector coordinates (local homographies), "
+      "camera/projector/stereo calibration; writes the calibration YAML only if every check "
+      "passes");
+  solve->add_option("capture", s.capture, "capture folder")->required();
+  solve->add_option("--out", s.out, "calibration YAML to write")->required();
+  solve->add_option("--report", s.report,
+                    "report folder (default: calibration_report beside --out)");
+  solve->add_option("--min-views", s.min_views, "refuse with fewer usable views")
+      ->capture_default_str();
+  solve->add_option("--max-camera-rms", s.max_camera_rms_px, "refuse above, px")
+      ->capture_default_str();
+  solve->add_option("--max-projector-rms", s.max_projector_rms_px, "refuse above, px")
+      ->capture_default_str();
+  solve
+      ->add_option("--min-coverage", s.min_coverage,
+                   "refuse below this fraction of a 4x4 grid reached by corners")
+      ->capture_default_str();
+  solve->callback([] { guarded("solve", [] { return run_solve(s); }); });
+
+  static BenchOptions b;
+  auto* bench = calib->add_subcommand(
+      "bench",
+      "Accuracy against simulator ground truth: seeded captures, solve, errors of the result "
+      "and the depth RMS of a plane decoded with it");
+  bench->add_flag("--json", b.json, "print one JSON object");
+  bench->add_option("--views", b.views, "board poses")->capture_default_str();
+  bench->add_option("--seed", b.seed, "poses and noise seed")->capture_default_str();
+  bench->add_option("--noise", b.noise_dn, "sensor noise sigma, DN")->capture_default_str();
+  bench->callback([] { guarded("bench", [] { return run_bench(b); }); });
+}
+
+}  // namespace
+
+AVS_REGISTER_COMMAND(add_calib_command)
+
+}  // namespace avs::cli
