@@ -22,9 +22,9 @@ TEST(CalibCommand, CaptureThenSolveWritesALoadableCalibration) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const fs::path log = dir / "log.txt", err = dir / "err.txt";
-  ASSERT_EQ(avs::testing::run_avs("calib capture --generate 10 --near 0.55 --far 1.6 --out " +
-                                      (dir / "capture").string(),
-                                  0, log, err),
+  ASSERT_EQ(avs::testing::run_avs({"calib", "capture", "--generate", "10", "--near", "0.55",
+                                   "--far", "1.6", "--out", (dir / "capture").string()},
+                                  log, err),
             0)
       << avs::testing::read_file(log) << avs::testing::read_file(err);
   const std::string capture_log = avs::testing::read_file(log);
@@ -32,10 +32,10 @@ TEST(CalibCommand, CaptureThenSolveWritesALoadableCalibration) {
   EXPECT_NE(capture_log.find("board found in 10"), std::string::npos) << capture_log;
 
   const fs::path calibration = dir / "out" / "calibration.yaml";
-  ASSERT_EQ(avs::testing::run_avs(
-                "calib solve " + (dir / "capture").string() + " --out " + calibration.string(), 0,
-                log, err),
-            0)
+  ASSERT_EQ(
+      avs::testing::run_avs(
+          {"calib", "solve", (dir / "capture").string(), "--out", calibration.string()}, log, err),
+      0)
       << avs::testing::read_file(log) << avs::testing::read_file(err);
   const avs::decode::SensorGeometry g = avs::decode::load_sensor_geometry_yaml(calibration);
   const avs::decode::SensorGeometry truth = avs::calib::bench_truth_geometry();
@@ -48,9 +48,9 @@ TEST(CalibCommand, CaptureThenSolveWritesALoadableCalibration) {
 
   // The same capture with a stricter rule is refused, with the reason, and writes nothing.
   const fs::path refused = dir / "refused.yaml";
-  EXPECT_EQ(avs::testing::run_avs("calib solve " + (dir / "capture").string() +
-                                      " --min-views 12 --out " + refused.string(),
-                                  0, log, err),
+  EXPECT_EQ(avs::testing::run_avs({"calib", "solve", (dir / "capture").string(), "--min-views",
+                                   "12", "--out", refused.string()},
+                                  log, err),
             1);
   EXPECT_NE(avs::testing::read_file(err).find("too few usable views: 10 (need 12"),
             std::string::npos)
@@ -61,8 +61,9 @@ TEST(CalibCommand, CaptureThenSolveWritesALoadableCalibration) {
 
 TEST(CalibCommand, UnimplementedSourcesSaySo) {
   const fs::path out = fs::temp_directory_path() / ("avs-calib-src-" + std::to_string(getpid()));
-  EXPECT_EQ(avs::testing::run_avs("calib capture --source bag --generate 3 --out " + out.string(),
-                                  0, out.string() + ".log", out.string() + ".err"),
+  EXPECT_EQ(avs::testing::run_avs(
+                {"calib", "capture", "--source", "bag", "--generate", "3", "--out", out.string()},
+                out.string() + ".log", out.string() + ".err"),
             2);
   EXPECT_NE(avs::testing::read_file(out.string() + ".err").find("NOT IMPLEMENTED"),
             std::string::npos);
@@ -72,8 +73,8 @@ TEST(CalibCommand, UnimplementedSourcesSaySo) {
 
 TEST(CalibCommand, BenchJsonHasTheIssueKeys) {
   const fs::path out = fs::temp_directory_path() / ("avs-calib-bench-" + std::to_string(getpid()));
-  ASSERT_EQ(avs::testing::run_avs("calib bench --json --views 8", 0, out.string() + ".json",
-                                  out.string() + ".err"),
+  ASSERT_EQ(avs::testing::run_avs({"calib", "bench", "--json", "--views", "8"},
+                                  out.string() + ".json", out.string() + ".err"),
             0)
       << avs::testing::read_file(out.string() + ".err");
   const std::string json = avs::testing::read_file(out.string() + ".json");
