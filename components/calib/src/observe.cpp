@@ -114,12 +114,30 @@ int ViewObservation::corners_with_projector() const {
 }
 
 std::vector<Eigen::Vector2d> find_board_corners(const decode::GrayImage8& white,
-                                                const sim::Checkerboard& board) {
+                                                const sim::Checkerboard& board,
+                                                int max_subpixel_half_window_px) {
   std::vector<cv::Point2f> found;
   const cv::Size pattern(board.inner_corners_x(), board.inner_corners_y());
   if (!cv::findChessboardCornersSB(as_mat(white), pattern, found,
                                    cv::CALIB_CB_EXHAUSTIVE | cv::CALIB_CB_ACCURACY)) {
     return {};
+  }
+  // Refined by cornerSubPix: findChessboardCornersSB's corners alone were biased through the
+  // camera's lens distortion (simulator, 16 views: focal 0.28 % and rotation 0.13 deg off; with
+  // the refinement 0.08 % and 0.04 deg). The window stays inside the squares: at most 0.4 of
+  // the smallest corner spacing, at most max_subpixel_half_window_px.
+  double spacing = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < found.size(); ++k) {
+    const bool row_end = (k + 1) % static_cast<std::size_t>(pattern.width) == 0;
+    if (!row_end) spacing = std::min(spacing, cv::norm(found[k + 1] - found[k]));
+    if (k + static_cast<std::size_t>(pattern.width) < found.size()) {
+      spacing = std::min(spacing, cv::norm(found[k + pattern.width] - found[k]));
+    }
+  }
+  const int half = std::min(max_subpixel_half_window_px, static_cast<int>(0.4 * spacing));
+  if (half >= 2) {
+    cv::cornerSubPix(as_mat(white), found, cv::Size(half, half), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
   }
   std::vector<Eigen::Vector2d> corners;
   for (const cv::Point2f& p : found) corners.emplace_back(p.x, p.y);
@@ -146,7 +164,8 @@ ViewObservation observe_view(const BoardView& view, const CaptureInfo& info,
     }
   }
   // 1. Corners in the white frame.
-  const std::vector<Eigen::Vector2d> corners = find_board_corners(view.frames[0], info.board);
+  const std::vector<Eigen::Vector2d> corners =
+      find_board_corners(view.frames[0], info.board, config.max_subpixel_half_window_px);
   if (corners.empty()) {
     out.problem = "board not found in the white frame";
     return out;

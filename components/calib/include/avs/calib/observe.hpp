@@ -1,8 +1,8 @@
 // Per board view: the board's inner corners in the camera image (OpenCV's
-// findChessboardCornersSB on the white frame) and, for each, its projector coordinates from
-// the decoded column and row Gray codes through a local homography around the corner (Moreno
-// and Taubin, "Simple, Accurate, and Robust Projector-Camera Calibration", 3DIMPVT 2012,
-// section 3). OpenCV is used inside observe.cpp only; this header has none of its types.
+// findChessboardCornersSB on the white frame, refined by cornerSubPix) and, for each, its projector
+// coordinates from the decoded column and row Gray codes through a local homography around the
+// corner (Moreno and Taubin, "Simple, Accurate, and Robust Projector-Camera Calibration", 3DIMPVT
+// 2012, section 3). OpenCV is used inside observe.cpp only; this header has none of its types.
 #pragma once
 
 #include <string>
@@ -15,6 +15,9 @@
 namespace avs::calib {
 
 struct ObserveConfig {
+  /// Corners from findChessboardCornersSB are refined by cornerSubPix with a window of this
+  /// half size (pixels), smaller where the squares are small; 0 or 1: no refinement.
+  int max_subpixel_half_window_px = 5;
   /// A camera pixel is decoded when white - black >= this (DN): the projector lights it.
   int min_contrast_dn = 8;
   /// A bit counts as unstable at a pixel when |positive - negative| < this (DN); a pixel with
@@ -57,9 +60,10 @@ struct ViewObservation {
 ViewObservation observe_view(const BoardView& view, const CaptureInfo& info,
                              const ObserveConfig& config = {});
 
-/// Only the camera corners (white frame): what `avs calib capture` reports per pose.
-/// Empty when the board is not found.
+/// The camera corners of the white frame (findChessboardCornersSB, then cornerSubPix; see
+/// ObserveConfig), in OpenCV's order. Empty when the board is not found.
 std::vector<Eigen::Vector2d> find_board_corners(const decode::GrayImage8& white,
-                                                const sim::Checkerboard& board);
+                                                const sim::Checkerboard& board,
+                                                int max_subpixel_half_window_px = 5);
 
 }  // namespace avs::calib
