@@ -30,7 +30,6 @@ dds_domainid_t prepare_domain(dds_domainid_t domain) {
 Participant::Participant(dds_domainid_t domain, std::string partition)
     : Entity(check_dds(dds_create_participant(prepare_domain(domain), nullptr, nullptr),
                        "create DDS participant on domain " + std::to_string(domain))),
-      domain_(domain),
       partition_(std::move(partition)) {}
 
 void Participant::apply_partition(dds_qos_t* qos) const {

@@ -152,7 +152,7 @@ int run_play(PlayArgs& a) {
         char c = 0;
         if (read(STDIN_FILENO, &c, 1) != 1) continue;
         if (c == ' ') paused = !paused;
-        if (c == 'q') stop_requested() = true;
+        if (c == 'q') request_stop();
       }
     });
   }

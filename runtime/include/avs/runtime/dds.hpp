@@ -48,14 +48,12 @@ class Entity {
 class Participant : public Entity {
  public:
   explicit Participant(dds_domainid_t domain = 0, std::string partition = {});
-  dds_domainid_t domain() const { return domain_; }
   const std::string& partition() const { return partition_; }
   /// Puts the partition into the QoS of a reader or writer of this participant (every
   /// endpoint of a user topic goes through this; built-in topic readers see all partitions).
   void apply_partition(dds_qos_t* qos) const;
 
  private:
-  dds_domainid_t domain_;
   std::string partition_;
 };
 
