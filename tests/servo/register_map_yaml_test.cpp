@@ -51,7 +51,7 @@ TEST(RegisterMapYaml, UnknownRegisterNameIsOneClearLine) {
   std::string yaml = valid_map;
   yaml += "  torque_demand: {address: 20}\n";
   const std::string error = error_of(yaml);
-  EXPECT_NE(error.find("servo.yaml:8: unknown register 'torque_demand'"), std::string::npos)
+  EXPECT_NE(error.find("servo.yaml:8:3: unknown register 'torque_demand'"), std::string::npos)
       << error;
   EXPECT_EQ(error.find('\n'), std::string::npos) << error;
 }
@@ -60,7 +60,7 @@ TEST(RegisterMapYaml, BadWordOrderIsOneClearLine) {
   std::string yaml = valid_map;
   yaml.replace(yaml.find("word_order: high_first"), 22, "word_order: middle");
   const std::string error = error_of(yaml);
-  EXPECT_NE(error.find("servo.yaml:7: register velocity_actual: bad word_order 'middle'"),
+  EXPECT_NE(error.find("servo.yaml:7:85: register velocity_actual: bad word_order 'middle'"),
             std::string::npos)
       << error;
   EXPECT_EQ(error.find('\n'), std::string::npos) << error;

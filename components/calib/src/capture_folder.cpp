@@ -124,14 +124,6 @@ std::string read_text(const std::filesystem::path& path, const char* what) {
   return text.str();
 }
 
-YAML::Node load(const std::string& text, const std::string& source) {
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
-}
-
 }  // namespace
 
 void write_capture_index(const std::filesystem::path& dir, const CaptureIndex& index) {
@@ -196,7 +188,8 @@ void write_view_frames(const std::filesystem::path& dir, const BoardView& view,
 
 CaptureIndex read_capture_index(const std::filesystem::path& dir) {
   const std::string source = (dir / "index.yaml").string();
-  const YAML::Node root = load(read_text(dir / "index.yaml", "capture index"), source);
+  const YAML::Node root =
+      runtime::yaml_parse(read_text(dir / "index.yaml", "capture index"), source);
   check_keys(source, root,
              {"format", "source", "camera", "projector", "column_code", "row_code",
               "depth_code_layout", "board", "truth_calibration", "frames", "views"},
@@ -283,7 +276,7 @@ BoardView read_view(const std::filesystem::path& dir, const ViewEntry& entry,
 }
 
 BoardPoses parse_board_poses_yaml(const std::string& text, const std::string& source) {
-  const YAML::Node root = load(text, source);
+  const YAML::Node root = runtime::yaml_parse(text, source);
   if (!root || !root.IsMap()) {
     throw std::runtime_error(source + ": expected a map with 'poses' (and optionally 'board')");
   }

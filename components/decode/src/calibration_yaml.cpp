@@ -73,12 +73,7 @@ void write_lens(YAML::Emitter& out, const char* name, const geometry::CameraMode
 }  // namespace
 
 SensorGeometry parse_sensor_geometry_yaml(const std::string& text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw std::runtime_error(source + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = runtime::yaml_parse(text, source);
   SensorGeometry g = default_sensor_geometry();
   if (!root || root.IsNull()) return g;
   check_keys(source, root,

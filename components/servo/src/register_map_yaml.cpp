@@ -2,15 +2,16 @@
 
 #include <sstream>
 
+#include "avs/runtime/yaml_checks.hpp"
 #include "avs/servo/modbus_handle.hpp"
 
 namespace avs::servo {
 namespace {
 
 [[noreturn]] void fail(std::string_view source, const YAML::Node& at, const std::string& what) {
-  std::string where(source);
-  if (at.IsDefined() && at.Mark().line >= 0) where += ":" + std::to_string(at.Mark().line + 1);
-  throw ConfigError(where + ": " + what);
+  throw ConfigError(
+      runtime::yaml_location(source, at.IsDefined() ? at.Mark() : YAML::Mark::null_mark()) + ": " +
+      what);
 }
 
 std::string known_signals() {
@@ -100,23 +101,25 @@ RegisterMap parse_register_map(const YAML::Node& root, std::string_view source) 
 }
 
 RegisterMap parse_register_map_string(const std::string& yaml_text, std::string_view source) {
+  YAML::Node root;
   try {
-    return parse_register_map(YAML::Load(yaml_text), source);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(std::string(source) + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    root = runtime::yaml_parse(yaml_text, std::string(source));
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(e.what());
+  }
+  return parse_register_map(root, source);
+}
+
+YAML::Node load_register_map_file(const std::string& path) {
+  try {
+    return runtime::yaml_load_file(path, "register map");
+  } catch (const std::runtime_error& e) {
+    throw ConfigError(e.what());  // the servo's configuration errors have one type
   }
 }
 
 RegisterMap load_register_map(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path + ": cannot open register map");
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
-  return parse_register_map(root, path);
+  return parse_register_map(load_register_map_file(path), path);
 }
 
 std::string register_map_to_yaml(const RegisterMap& map) {

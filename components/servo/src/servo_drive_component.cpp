@@ -25,6 +25,7 @@
 #include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
+#include "avs/runtime/text.hpp"
 #include "avs/servo/amplifier_server.hpp"
 #include "avs/servo/drive_client.hpp"
 #include "avs/servo/plant.hpp"
@@ -49,21 +50,14 @@ double element(const std::vector<double>& list, std::size_t i, const std::string
 /// The register map(s) of `register_map` (docs/servo.md): a file with one map for every axis,
 /// or `axes: {<name>: <map>, ...}` with one map per axis name.
 std::vector<RegisterMap> load_maps(const std::string& path, const std::vector<std::string>& names) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path + ": cannot open register map");
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = load_register_map_file(path);
   std::vector<RegisterMap> maps;
   if (root.IsMap() && root["axes"]) {
     const YAML::Node axes = root["axes"];
     for (const std::string& name : names) {
       if (!axes[name]) {
-        throw ConfigError(path + ":" + std::to_string(axes.Mark().line + 1) +
-                          ": axes: no map for axis '" + name + "'");
+        throw ConfigError(runtime::yaml_location(path, axes.Mark()) + ": axes: no map for axis '" +
+                          name + "'");
       }
       maps.push_back(parse_register_map(axes[name], path));
     }

@@ -15,6 +15,7 @@
 #include "avs/geometry/builtin_models.hpp"
 #include "avs/geometry/primitives.hpp"
 #include "avs/runtime/text.hpp"
+#include "avs/runtime/yaml_checks.hpp"
 
 namespace avs::sim {
 namespace {
@@ -209,13 +210,7 @@ class Parser {
 
 SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_errors,
                       const std::string& base_dir, const std::string& models_dir) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yaml_text);
-  } catch (const YAML::ParserException& e) {
-    throw std::runtime_error(name_for_errors + ":" + std::to_string(e.mark.line + 1) + ":" +
-                             std::to_string(e.mark.column + 1) + ": " + e.msg);
-  }
+  const YAML::Node root = runtime::yaml_parse(yaml_text, name_for_errors);
   Parser parser(name_for_errors, base_dir, models_dir);
   if (!root.IsMap()) parser.fail(root, "a scene file is a map with an 'objects' list");
   SceneFile file;

@@ -3,7 +3,9 @@
 // Written once (issue 14); include only where yaml-cpp is already used.
 #pragma once
 
+#include <fstream>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -18,6 +20,26 @@ namespace avs::runtime {
 [[noreturn]] inline void yaml_fail(const std::string& source, const YAML::Node& node,
                                    const std::string& what) {
   throw std::runtime_error(yaml_location(source, node.Mark()) + ": " + what);
+}
+
+/// `text` parsed as one YAML document; a syntax error throws std::runtime_error
+/// "source:line:column: what yaml-cpp says".
+inline YAML::Node yaml_parse(const std::string& text, const std::string& source) {
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw std::runtime_error(yaml_location(source, e.mark) + ": " + e.msg);
+  }
+}
+
+/// The file at `path` parsed as YAML; `what` names it when it cannot be opened
+/// ("path: cannot open register map").
+inline YAML::Node yaml_load_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open " + what);
+  std::stringstream text;
+  text << in.rdbuf();
+  return yaml_parse(text.str(), path);
 }
 
 /// `node` must be a map whose keys are all in `allowed`; `section` names it in errors.

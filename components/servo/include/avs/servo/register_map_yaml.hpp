@@ -4,7 +4,7 @@
 //     controlword:     {address: 0}
 //     target_torque:   {address: 1, signed: true, scale: 0.00191}
 //     position_actual: {address: 8, size: 32, signed: true, word_order: low_first, scale: 1.1e-5}
-// Every error is a ConfigError with one line "<source>:<line>: <what>".
+// Every error is a ConfigError with one line "<source>:<line>:<column>: <what>".
 #pragma once
 
 #include <string>
@@ -20,6 +20,8 @@ namespace avs::servo {
 RegisterMap parse_register_map(const YAML::Node& node, std::string_view source);
 RegisterMap parse_register_map_string(const std::string& yaml_text, std::string_view source);
 RegisterMap load_register_map(const std::string& path);
+/// The YAML of a register-map file (one map, or `axes:` with one per axis), unparsed.
+YAML::Node load_register_map_file(const std::string& path);
 
 /// The inverse, for docs and round trips.
 std::string register_map_to_yaml(const RegisterMap& map);
