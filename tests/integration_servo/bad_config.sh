@@ -15,7 +15,7 @@ check() {  # file, expected text
   printf '%s\n' "$line" | grep -q -- "$2" || fail "$1: error does not say '$2': $line"
   echo "ok  $1: $line"
 }
-check unknown_register.yaml "unknown_register.yaml:7: unknown register 'torque_demand'"
-check bad_word_order.yaml "bad_word_order.yaml:8: register velocity_actual: bad word_order 'middle'"
+check unknown_register.yaml "unknown_register.yaml:7:3: unknown register 'torque_demand'"
+check bad_word_order.yaml "bad_word_order.yaml:8:70: register velocity_actual: bad word_order 'middle'"
 check word_order_mismatch.yaml "word_order_probe reads 0x56781234, expected 0x12345678"
 echo PASS

@@ -1,7 +1,8 @@
 // Issue 20 1.5: Modbus TCP replies with a wrong MBAP unit id or a length of 0xFFFF were
 // accepted. A proxy on 127.0.0.1 between the drive client and the simulated amplifier
 // corrupts one cyclic (0x17) reply on request; the client must reject it (link fault, torque
-// 0, counted), never throw, and recover through its reconnect.
+// 0, counted), never throw, and recover through its reconnect. The reads and writes of the
+// connection's configuration are checked the same way: a corrupted one fails the connect.
 #include <arpa/inet.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
@@ -30,7 +31,7 @@ enum class Corruption : int {
   wrong_unit_id,       ///< MBAP unit id of the other axis
   length_ffff,         ///< MBAP length field 0xFFFF
   short_byte_count,    ///< 0x17 byte count (and the frame) one register short
-  wrong_function_code  ///< a 0x03 reply to a 0x17 request
+  wrong_function_code  ///< a 0x03 reply to a 0x17 or 0x10 request, 0x04 to a 0x03 one
 };
 
 bool read_exact(int fd, std::uint8_t* data, std::size_t size) {
@@ -93,7 +94,12 @@ class CorruptingProxy {
   CorruptingProxy& operator=(const CorruptingProxy&) = delete;
 
   int port() const { return port_; }
-  void corrupt_next_cyclic_reply(Corruption c) { next_.store(static_cast<int>(c)); }
+  /// Corrupts the next reply to a request with function code `function` (0x17: the cyclic
+  /// write-and-read; 0x03 and 0x10: the configuration's reads and writes).
+  void corrupt_next_reply(Corruption c, std::uint8_t function = 0x17) {
+    function_.store(function);
+    next_.store(static_cast<int>(c));
+  }
   int corrupted_replies() const { return corrupted_.load(); }
 
  private:
@@ -134,7 +140,7 @@ class CorruptingProxy {
       if (::poll(&p, 1, 20) <= 0) continue;
       if (!read_frame(client, request)) return;  // the client closed (reconnect)
       if (!write_all(upstream, request) || !read_frame(upstream, reply)) return;
-      if (request[7] == 0x17) corrupt(reply);
+      if (request[7] == function_.load()) corrupt(reply);
       if (!write_all(client, reply)) return;
     }
   }
@@ -160,7 +166,7 @@ class CorruptingProxy {
         break;
       }
       case Corruption::wrong_function_code:
-        reply[7] = 0x03;
+        reply[7] = reply[7] == 0x03 ? 0x04 : 0x03;
         break;
     }
     ++corrupted_;
@@ -171,6 +177,7 @@ class CorruptingProxy {
   int port_ = 0;
   std::atomic<bool> stop_{false};
   std::atomic<int> next_{static_cast<int>(Corruption::none)};
+  std::atomic<std::uint8_t> function_{0x17};
   std::atomic<int> corrupted_{0};
   std::thread thread_;
 };
@@ -211,7 +218,7 @@ class BadReplyTest : public ::testing::TestWithParam<Corruption> {
 
 TEST_P(BadReplyTest, IsRejectedCountedAndTheLinkRecovers) {
   ASSERT_TRUE(cycle().link_ok);
-  proxy_->corrupt_next_cyclic_reply(GetParam());
+  proxy_->corrupt_next_reply(GetParam());
   CycleResult r;
   ASSERT_NO_THROW(r = cycle());  // pan's exchange gets the bad reply
   ASSERT_EQ(proxy_->corrupted_replies(), 1);
@@ -227,6 +234,27 @@ TEST_P(BadReplyTest, IsRejectedCountedAndTheLinkRecovers) {
   for (int i = 0; i < 20 && !recovered; ++i) recovered = cycle().link_ok;
   EXPECT_TRUE(recovered);
   EXPECT_GE(client_->statistics().reconnects, 1u);
+}
+
+TEST_P(BadReplyTest, InAConfigurationReadOrWriteFailsTheConnect) {
+  client_.reset();  // the proxy serves one connection at a time
+  for (const std::uint8_t function : {std::uint8_t{0x03}, std::uint8_t{0x10}}) {
+    SCOPED_TRACE("function " + std::to_string(function));
+    DriveClientConfig c = default_drive_client_config("127.0.0.1", proxy_->port());
+    c.cycle_rate_hz = rate_hz;
+    c.response_timeout_s = 0.02;
+    DriveClient fresh(c);
+    const int before = proxy_->corrupted_replies();
+    proxy_->corrupt_next_reply(GetParam(), function);
+    try {
+      fresh.connect();
+      ADD_FAILURE() << "connect accepted a corrupted configuration reply";
+    } catch (const ModbusError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad reply"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(proxy_->corrupted_replies(), before + 1);
+    EXPECT_NO_THROW(fresh.connect());  // a clean connection is trusted again
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Corruptions, BadReplyTest,

@@ -158,8 +158,7 @@ void DriveClient::open_link() {
     ctx =
         make_rtu_context(r.device, r.line.baud, r.line.parity, r.line.data_bits, r.line.stop_bits);
   }
-  set_response_timeout(ctx.get(),
-                       std::max(config_.configure_timeout_s, config_.response_timeout_s));
+  set_response_timeout(ctx.get(), configure_timeout_s());
   const std::string peer = config_.transport == Transport::tcp
                                ? config_.tcp.host + ":" + std::to_string(config_.tcp.port)
                                : config_.rtu.device;
@@ -190,8 +189,8 @@ void DriveClient::configure_axes() {
     if (map.has(Signal::word_order_probe)) {
       const RegisterSpec& probe = map[Signal::word_order_probe];
       std::uint16_t regs[2] = {0, 0};
-      check_modbus(modbus_read_registers(ctx_.get(), probe.address, probe.width_registers, regs),
-                   label + ": read word_order_probe");
+      configure_read(axis, probe.address, std::span(regs, probe.width_registers),
+                     label + ": read word_order_probe");
       const auto value = static_cast<std::uint32_t>(read_counts(probe, regs));
       if (value != word_order_probe_value) {
         char msg[256];
@@ -205,13 +204,14 @@ void DriveClient::configure_axes() {
     }
     // Torque off and disabled before anything else (ros2_control #674: no stale commands).
     if (map.has(Signal::target_torque)) {
-      check_modbus(modbus_write_register(ctx_.get(), map[Signal::target_torque].address, 0),
-                   label + ": write target_torque 0");
+      const std::uint16_t zero = 0;
+      configure_write(axis, map[Signal::target_torque].address, std::span(&zero, 1),
+                      label + ": write target_torque 0");
     }
     if (map.has(Signal::mode_of_operation)) {
-      check_modbus(modbus_write_register(ctx_.get(), map[Signal::mode_of_operation].address,
-                                         static_cast<std::uint16_t>(axis.mode_of_operation)),
-                   label + ": write mode_of_operation");
+      const auto mode = static_cast<std::uint16_t>(axis.mode_of_operation);
+      configure_write(axis, map[Signal::mode_of_operation].address, std::span(&mode, 1),
+                      label + ": write mode_of_operation");
     }
     if (map.has(Signal::max_torque)) {
       // Drive-side limit = the host's limit: it still holds if the host is wrong.
@@ -220,16 +220,50 @@ void DriveClient::configure_axes() {
           std::min(axis.safety.configured_max_torque_nm, axis.safety.motor_max_torque_nm);
       std::uint16_t regs[2] = {0, 0};
       write_counts(spec, to_counts(spec, limit), regs);
-      check_modbus(modbus_write_registers(ctx_.get(), spec.address, spec.width_registers, regs),
-                   label + ": write max_torque");
+      configure_write(axis, spec.address, std::span(regs, spec.width_registers),
+                      label + ": write max_torque");
     }
     if (map.has(Signal::echo_counter)) {
       std::uint16_t echo = 0;
-      check_modbus(modbus_read_registers(ctx_.get(), map[Signal::echo_counter].address, 1, &echo),
-                   label + ": read echo_counter");
+      configure_read(axis, map[Signal::echo_counter].address, std::span(&echo, 1),
+                     label + ": read echo_counter");
       axes_[i].counter = echo;
     }
   }
+}
+
+void DriveClient::configure_read(const DriveAxisConfig& axis, std::uint16_t address,
+                                 std::span<std::uint16_t> registers, const std::string& what) {
+  if (config_.transport == Transport::tcp) {
+    std::string message;
+    if (tcp_transaction(
+            static_cast<std::uint8_t>(axis.unit_id),
+            read_registers_request(address, static_cast<std::uint16_t>(registers.size())),
+            registers, message, configure_timeout_s()) != ExchangeError::none) {
+      throw ModbusError(what + ": " + message);
+    }
+    return;
+  }
+  // RTU: libmodbus checks the slave address, CRC, function and byte count itself.
+  check_modbus(modbus_read_registers(ctx_.get(), address, static_cast<int>(registers.size()),
+                                     registers.data()),
+               what);
+}
+
+void DriveClient::configure_write(const DriveAxisConfig& axis, std::uint16_t address,
+                                  std::span<const std::uint16_t> values, const std::string& what) {
+  if (config_.transport == Transport::tcp) {
+    std::string message;
+    if (tcp_transaction(static_cast<std::uint8_t>(axis.unit_id),
+                        write_registers_request(address, values), {}, message,
+                        configure_timeout_s()) != ExchangeError::none) {
+      throw ModbusError(what + ": " + message);
+    }
+    return;
+  }
+  check_modbus(
+      modbus_write_registers(ctx_.get(), address, static_cast<int>(values.size()), values.data()),
+      what);
 }
 
 void DriveClient::connect() {
@@ -412,7 +446,7 @@ ReadResult read_exact(int fd, std::span<std::uint8_t> out,
 DriveClient::ExchangeError DriveClient::tcp_transaction(std::uint8_t unit_id,
                                                         const RequestPdu& request,
                                                         std::span<std::uint16_t> registers,
-                                                        std::string& message) {
+                                                        std::string& message, double timeout_s) {
   const int fd = modbus_get_socket(ctx_.get());
   transaction_id_ = static_cast<std::uint16_t>(transaction_id_ + 1);
   const std::vector<std::uint8_t> adu = encode_tcp_request(transaction_id_, unit_id, request);
@@ -427,7 +461,7 @@ DriveClient::ExchangeError DriveClient::tcp_transaction(std::uint8_t unit_id,
   }
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                            std::chrono::duration<double>(config_.response_timeout_s));
+                            std::chrono::duration<double>(timeout_s));
   auto failed = [&](ReadResult r) {
     message = r == ReadResult::timeout ? "Connection timed out" : "connection closed by the peer";
     return r == ReadResult::timeout ? ExchangeError::timeout : ExchangeError::io;
@@ -487,19 +521,19 @@ DriveClient::ExchangeError DriveClient::exchange(std::size_t axis, std::uint16_t
           unit,
           write_read_registers_request(base, std::span(image, rt.write_runs.front().count),
                                        rt.read_address, rt.read_count),
-          regs, message);
+          regs, message, config_.response_timeout_s);
     } else {
       for (const WriteRun& run : rt.write_runs) {
         if (error != ExchangeError::none) break;
-        error = tcp_transaction(
-            unit,
-            write_registers_request(run.address,
-                                    std::span(image + (run.address - base), run.count)),
-            {}, message);
+        error =
+            tcp_transaction(unit,
+                            write_registers_request(
+                                run.address, std::span(image + (run.address - base), run.count)),
+                            {}, message, config_.response_timeout_s);
       }
       if (error == ExchangeError::none) {
         error = tcp_transaction(unit, read_registers_request(rt.read_address, rt.read_count), regs,
-                                message);
+                                message, config_.response_timeout_s);
       }
     }
   } else {

@@ -5,6 +5,7 @@
 // set_command()/set_estop() may be called from other threads.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <mutex>
@@ -194,7 +195,19 @@ class DriveClient {
   /// TCP: one request and its reply over the connected socket, the reply checked in full
   /// (modbus_frame.hpp) before any register is taken.
   ExchangeError tcp_transaction(std::uint8_t unit_id, const RequestPdu& request,
-                                std::span<std::uint16_t> registers, std::string& message);
+                                std::span<std::uint16_t> registers, std::string& message,
+                                double timeout_s);
+  /// A configure-time read or write of `axis`, checked like the cyclic exchanges (over TCP
+  /// through tcp_transaction: unit id, transaction id, length); throws ModbusError naming
+  /// `what` when it fails.
+  void configure_read(const DriveAxisConfig& axis, std::uint16_t address,
+                      std::span<std::uint16_t> registers, const std::string& what);
+  void configure_write(const DriveAxisConfig& axis, std::uint16_t address,
+                       std::span<const std::uint16_t> values, const std::string& what);
+  /// The reply budget while connecting (drives answer configuration writes slower).
+  double configure_timeout_s() const {
+    return std::max(config_.configure_timeout_s, config_.response_timeout_s);
+  }
   static ExchangeError classify_modbus_errno(int err);
   void on_link_fault(double now_s, ExchangeError error, const std::string& message);
 
