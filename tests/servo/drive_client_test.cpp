@@ -170,6 +170,10 @@ TEST_F(DriveClientTest, FutureStampedCommandIsRejected) {
   // Within the tolerance a stamp ahead is taken, but it ages from its arrival as well.
   EXPECT_TRUE(client_->set_command({1.0, 0.1}, t_ + 0.004, t_));
   EXPECT_GT(cycle().axes[0].commanded_torque_nm, 0.5);
+  CycleResult r;
+  for (int i = 0; i < 4; ++i) r = cycle();  // 4 periods from its arrival > the 3-period timeout
+  EXPECT_EQ(r.axes[0].commanded_torque_nm, 0.0);
+  EXPECT_TRUE(r.axes[0].safety_reasons & safety_command_stale);
 }
 
 TEST_F(DriveClientTest, EstopGivesZeroTorqueWithinOnePeriod) {
