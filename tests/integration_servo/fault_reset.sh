@@ -10,7 +10,6 @@ set -euo pipefail
 avs=$1; src=$2
 . "$src/tests/integration_servo/lib.sh"
 out=$(mktemp -d)
-launch_pid=
 trap '[ -n "$launch_pid" ] && kill "$launch_pid" 2>/dev/null; rm -rf "$out"' EXIT
 args=(duration_s:=0.5 "torque_nm:=[0.05, 0.01]" step_at_s:=0.05 step_until_s:=10
       fault_at_s:=0.2 fault_axis:=0 auto_fault_reset:=false)
@@ -27,24 +26,12 @@ awk -v t="$back" 'BEGIN {exit !(t > 0.305 && t <= 0.32)}' || fail "not after res
 awk -F, 'NR>1 && $1>0.2 && $5!=0 {print "FAIL: pan torque without a reset: " $0; exit 1}' "$out/none/drive.csv"
 grep -q "fault reset requested" "$out/reset/stderr.txt" || fail "the reset request was not logged"
 
-# 2. `avs head reset` against the running graph (realtime sim clock; waits are generous and
-# only bound the test: nothing below depends on how fast the machine is).
-mkdir -p "$out/live"
-"$avs" launch "$graph" port:=$port report_dir:="$out/live" "${args[@]}" clock_mode:=realtime \
-  duration_s:=120 2>"$out/live/stderr.txt" &
-launch_pid=$!
-wait_for() {  # wait_for PATTERN: until the launch's log has it (at most 60 s)
-  for _ in $(seq 600); do
-    grep -q "$1" "$out/live/stderr.txt" && return 0
-    kill -0 "$launch_pid" 2>/dev/null || { cat "$out/live/stderr.txt" >&2; fail "the graph ended"; }
-    sleep 0.1
-  done
-  cat "$out/live/stderr.txt" >&2; fail "no '$1' in the log"
-}
+# 2. `avs head reset` against the running graph.
+start_live "$out/live" "${args[@]}" duration_s:=120
 wait_for "drive fault, error code 0x5000"
 "$avs" head reset --wait 20 || fail "avs head reset failed"
 wait_for "link and drives healthy again"
-kill -TERM "$launch_pid"; wait "$launch_pid" || true; launch_pid=
+stop_live
 csv="$out/live/drive.csv"
 [ -s "$csv" ] || fail "no report from the live run"
 fault=$(awk -F, 'NR>1 && $1>0.2 && $5==0 {print $1; exit}' "$csv")

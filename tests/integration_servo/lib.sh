@@ -15,3 +15,24 @@ run_head() {
 }
 # column FILE NAME: index (1-based) of column NAME in the CSV header of FILE.
 column() { head -1 "$1" | tr ',' '\n' | grep -nx "$2" | cut -d: -f1; }
+# start_live DIR [name:=value ...]: launches the head graph in realtime sim time in the
+# background (launch_pid, live_log); stop_live ends it. Waits only bound the tests: nothing
+# depends on how fast the machine is.
+launch_pid=
+start_live() {
+  local dir=$1; shift
+  mkdir -p "$dir"
+  live_log="$dir/stderr.txt"
+  "$avs" launch "$graph" port:=$port report_dir:="$dir" clock_mode:=realtime "$@" 2>"$live_log" &
+  launch_pid=$!
+}
+stop_live() { kill -TERM "$launch_pid"; wait "$launch_pid" || true; launch_pid=; }
+# wait_for PATTERN: until the live launch's log has it (at most 60 s).
+wait_for() {
+  for _ in $(seq 600); do
+    grep -q "$1" "$live_log" && return 0
+    kill -0 "$launch_pid" 2>/dev/null || { cat "$live_log" >&2; fail "the graph ended"; }
+    sleep 0.1
+  done
+  cat "$live_log" >&2; fail "no '$1' in the log"
+}
