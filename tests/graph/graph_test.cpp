@@ -223,6 +223,14 @@ TEST_F(GraphTest, UndefinedArgSubstitution) {
   expect_one_error("undefined_arg.yaml", 8, 31,
                    {"undefined argument 'rate' in '$(arg rate)'", "did you mean 'rate_hz'"});
 }
+// Issue 20 section 2: `a: $(arg a)` made the component silently disappear (no error at all).
+TEST_F(GraphTest, ArgumentDefaultThatUsesItselfIsAnError) {
+  expect_one_error("self_arg.yaml", 2, 9, {"argument 'rate' in '$(arg rate)' has no value here"});
+}
+TEST_F(GraphTest, ArgumentDefaultThatUsesALaterArgumentIsAnError) {
+  expect_one_error("later_arg.yaml", 2, 11,
+                   {"argument 'rate' in '$(arg rate)' has no value here", "declared above it"});
+}
 TEST_F(GraphTest, UnsetEnvironmentVariable) {
   ASSERT_EQ(std::getenv("AVS_GRAPH_TEST_NEVER_SET"), nullptr);
   expect_one_error("unset_env.yaml", 6, 29, {"environment variable 'AVS_GRAPH_TEST_NEVER_SET'"});

@@ -55,14 +55,18 @@ void read_args(LoadState& state, FileReader& reader, const Entry* args_entry,
                const GivenArgs& given, bool top_level) {
   std::vector<std::string> declared;
   if (args_entry != nullptr) {
-    for (const auto& e : map_entries(reader, args_entry->value, "'args'", {})) {
+    const std::vector<Entry> entries = map_entries(reader, args_entry->value, "'args'", {});
+    // All names first, so that a default using an argument declared below it is told so.
+    for (const auto& e : entries) {
+      if (is_identifier(e.key)) reader.declared_args.push_back(e.key);
+    }
+    for (const auto& e : entries) {
       const std::string what = "argument '" + e.key + "'";
       if (!is_identifier(e.key)) {
         reader.error(e.key_node, what + ": expected a name of letters, digits and '_'");
         continue;
       }
       declared.push_back(e.key);
-      reader.declared_args.push_back(e.key);
       if (auto it = given.values.find(e.key); it != given.values.end()) {
         reader.args[e.key] = it->second;
         continue;
@@ -77,9 +81,14 @@ void read_args(LoadState& state, FileReader& reader, const Entry* args_entry,
         reader.error(e.key_node, what + " has no default and was not given" +
                                      (top_level ? " (add " + e.key + ":=VALUE to the command line)"
                                                 : " (give it in the include's 'args')"));
+        reader.failed_args.push_back(e.key);
         continue;
       }
-      if (auto text = default_text(reader, def, what + " default")) reader.args[e.key] = *text;
+      if (auto text = default_text(reader, def, what + " default")) {
+        reader.args[e.key] = *text;
+      } else {
+        reader.failed_args.push_back(e.key);  // default_text reported why
+      }
     }
   }
   for (const auto& [name, value] : given.values) {

@@ -73,10 +73,18 @@ std::optional<std::string> FileReader::substitute(std::string_view text,
       auto it = args.find(words[1]);
       const bool declared =
           std::find(declared_args.begin(), declared_args.end(), words[1]) != declared_args.end();
+      const bool failed =
+          std::find(failed_args.begin(), failed_args.end(), words[1]) != failed_args.end();
       if (it != args.end()) {
         out += it->second;
-      } else if (declared) {
+      } else if (failed) {
         ok = false;  // declared without a usable value: already reported at the declaration
+      } else if (declared) {
+        // Declared, but its value is being worked out (`a: $(arg a)`) or comes later.
+        diags->error(where, "argument '" + words[1] + "' in '" + whole +
+                                "' has no value here: a default may use only the arguments "
+                                "declared above it, never itself");
+        ok = false;
       } else {
         diags->error(where,
                      "undefined argument '" + words[1] + "' in '" + whole + "'" +

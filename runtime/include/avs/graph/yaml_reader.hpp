@@ -42,6 +42,7 @@ struct FileReader {
   std::string file;
   std::map<std::string, std::string> args;  ///< this file's arguments after overrides
   std::vector<std::string> declared_args;   ///< in file order, with or without a value
+  std::vector<std::string> failed_args;     ///< declared, and its error already reported
   Diagnostics* diags = nullptr;
 
   /// 1-based location of `node` (yaml-cpp marks are 0-based); 1:1 when unknown.
