@@ -14,6 +14,10 @@
 namespace {
 std::atomic<long> g_allocations{0};
 }  // namespace
+// GCC 12 at -O1 inlines these into one another and then reports free() of memory from
+// operator new as mismatched: both are ours and use malloc/free, so the pair does match.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void* operator new(std::size_t size) {
   ++g_allocations;
   if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
@@ -25,6 +29,7 @@ void operator delete(void* p) noexcept {
 void operator delete(void* p, std::size_t) noexcept {
   std::free(p);
 }
+#pragma GCC diagnostic pop
 
 namespace avs::matching {
 namespace {
