@@ -4,27 +4,21 @@
 // writes frame k of the simulator's Gray-code sequence (section 4.1: 2n frames per cycle, the
 // scene at start_time_s + k / frame_rate_hz, the head at rest) into each buffer, with the
 // camera frame id of k (16-bit GigE ids from first_frame_id, 0 skipped) and the timestamp
-// k / frame_rate_hz (an ideal triggered camera's clock) or the host's clock. Frames listed in
-// drop_frames are skipped (their ids never appear) and lost_packet_ratio drops GVSP packets,
-// to test what the `camera` component makes of gaps. Frames are rendered live (as fast as the
-// renderer goes) or, with prerender_cycles > 0, rendered once at start and repeated (a static
-// view at full rate). The fake camera only free-runs: its hardware-trigger mode sends nothing.
-#include <arv.h>
-
+// (k + 1) / frame_rate_hz (an ideal triggered camera's clock) or the host's clock. Frames in
+// drop_frames are skipped (their ids never appear) and lost_packet_ratio drops GVSP packets
+// (Aravis > 0.8.26 only; refused on Debian 12's 0.8.26), to test what the `camera` component
+// makes of gaps. Frames are rendered live (as fast as the renderer goes) or, with
+// prerender_cycles > 0, rendered once at start and repeated (a static view at full rate). The
+// fake camera only free-runs: its hardware-trigger mode sends nothing.
 #include <algorithm>
-#include <atomic>
-#include <cstring>
 #include <memory>
-#include <mutex>
-#include <set>
-#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "avs/runtime/component.hpp"
 #include "avs/sim/scene_yaml.hpp"
 #include "avs/sim/simulator.hpp"
-#include "glib_handles.hpp"
+#include "sim_gige_camera.hpp"
 
 namespace avs::camera {
 
@@ -72,15 +66,19 @@ class SimCamera final : public runtime::Component {
         .subscribes = {}};
   }
 
-  explicit SimCamera(ComponentContext& ctx)
-      : Component(ctx),
-        rate_hz_(ctx.param<double>("frame_rate_hz")),
-        start_time_s_(ctx.param<double>("start_time_s")),
-        first_id_(static_cast<std::uint64_t>(ctx.param<std::int64_t>("first_frame_id"))),
-        host_stamps_(ctx.param<std::string>("timestamps") == "host") {
+  explicit SimCamera(ComponentContext& ctx) : Component(ctx) {
+    SimGigECameraConfig c;
+    c.interface = ctx.param<std::string>("interface");
+    c.serial = ctx.param<std::string>("serial");
+    c.frame_rate_hz = ctx.param<double>("frame_rate_hz");
+    c.first_frame_id = static_cast<std::uint64_t>(ctx.param<std::int64_t>("first_frame_id"));
     for (double k : ctx.param<std::vector<double>>("drop_frames")) {
-      drop_.insert(static_cast<std::uint64_t>(k));
+      c.drop_frames.insert(static_cast<std::uint64_t>(k));
     }
+    c.host_timestamps = ctx.param<std::string>("timestamps") == "host";
+    c.lost_packet_ratio = ctx.param<double>("lost_packet_ratio");
+    rate_hz_ = c.frame_rate_hz;
+    start_time_s_ = ctx.param<double>("start_time_s");
     sim_ = make_simulator(ctx);
     const auto cycles = ctx.param<std::int64_t>("prerender_cycles");
     const auto per_cycle =
@@ -88,51 +86,29 @@ class SimCamera final : public runtime::Component {
     for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(cycles) * per_cycle; ++k) {
       prerendered_.push_back(render(k));
     }
-    const std::string interface = ctx.param<std::string>("interface");
-    const std::string serial = ctx.param<std::string>("serial");
-    fake_.reset(arv_gv_fake_camera_new_full(interface.c_str(), serial.c_str(), nullptr));
-    if (fake_ == nullptr || !arv_gv_fake_camera_is_running(fake_.get())) {
-      throw runtime::Error("sim_camera: cannot serve a GigE Vision camera on '" + interface +
-                           "' (GVCP port 3956): no such interface, or the port is taken by "
-                           "another (fake) camera");
-    }
-    if (const double ratio = ctx.param<double>("lost_packet_ratio"); ratio > 0) {
-      // GvFakeCamera's "gvsp-lost-packet-ratio" property came after Aravis 0.8.26 (Debian 12).
-      if (g_object_class_find_property(G_OBJECT_GET_CLASS(fake_.get()), "gvsp-lost-packet-ratio") ==
-          nullptr) {
-        throw runtime::Error("sim_camera: lost_packet_ratio " + std::to_string(ratio) +
-                             " needs the GV fake camera's gvsp-lost-packet-ratio property, which "
-                             "this Aravis (" +
-                             std::to_string(arv_get_major_version()) + "." +
-                             std::to_string(arv_get_minor_version()) + "." +
-                             std::to_string(arv_get_micro_version()) +
-                             ") does not have; use drop_frames");
-      }
-      g_object_set(fake_.get(), "gvsp-lost-packet-ratio", ratio, nullptr);
-    }
-    ArvFakeCamera* camera = arv_gv_fake_camera_get_fake_camera(fake_.get());
-    arv_fake_camera_set_trigger_frequency(camera, rate_hz_);
-    arv_fake_camera_set_fill_pattern(camera, &SimCamera::fill_pattern, this);
-    log().info("serving the simulator as GigE Vision camera serial ", serial, " on ", interface,
-               ": ", sim_->config().renderer.geometry.camera.width, "x",
-               sim_->config().renderer.geometry.camera.height, " Mono8, ", rate_hz_,
+    const auto& size = sim_->config().renderer.geometry.camera;
+    camera_ = std::make_unique<SimGigECamera>(
+        c, size.width, size.height, [this](std::uint64_t k, std::uint8_t* out) {
+          if (!prerendered_.empty()) {
+            const auto& image = prerendered_[k % prerendered_.size()];
+            std::copy(image.begin(), image.end(), out);
+          } else {
+            const std::vector<std::uint8_t> image = render(k);
+            std::copy(image.begin(), image.end(), out);
+          }
+        });
+    log().info("serving the simulator as GigE Vision camera serial ", c.serial, " on ", c.interface,
+               ": ", size.width, "x", size.height, " Mono8, ", rate_hz_,
                " Hz at most (free-run; the fake camera's trigger mode sends nothing), ",
                prerendered_.empty() ? std::string("rendered live")
                                     : std::to_string(prerendered_.size()) + " frames repeated",
-               ", ", drop_.size(), " frames dropped on purpose");
-  }
-
-  ~SimCamera() override {
-    // Stop the fake camera's thread before the callback's data goes.
-    if (fake_)
-      arv_fake_camera_set_fill_pattern(arv_gv_fake_camera_get_fake_camera(fake_.get()), nullptr,
-                                       nullptr);
-    fake_.reset();
+               ", ", c.drop_frames.size(), " frames dropped on purpose");
   }
 
   void on_deactivate() override {
-    log().info(filled_.load(), " frames sent (", skipped_.load(), " skipped on purpose, ",
-               mismatched_.load(), " with a ROI or pixel format other than the scene's)");
+    log().info(camera_->frames_sent(), " frames sent (", camera_->frames_skipped(),
+               " skipped on purpose, ", camera_->frames_mismatched(),
+               " with a ROI or pixel format other than the scene's)");
   }
 
  private:
@@ -155,58 +131,11 @@ class SimCamera final : public runtime::Component {
     return std::move(frame.image.pixels);
   }
 
-  /// GigE Vision block id of frame k: 16 bits, 0 skipped.
-  std::uint64_t frame_id(std::uint64_t k) const { return (first_id_ - 1 + k) % 65535 + 1; }
-
-  static void fill_pattern(ArvBuffer* buffer, void* self, guint32 /*exposure_time_us*/,
-                           guint32 /*gain*/, ArvPixelFormat pixel_format) {
-    static_cast<SimCamera*>(self)->fill(buffer, pixel_format);
-  }
-
-  /// On the fake camera's thread: frame k into the buffer it is about to send.
-  void fill(ArvBuffer* buffer, ArvPixelFormat pixel_format) {
-    std::uint64_t k = next_++;
-    while (drop_.contains(k)) {
-      k = next_++;
-      ++skipped_;
-    }
-    const int width = arv_buffer_get_image_width(buffer);
-    const int height = arv_buffer_get_image_height(buffer);
-    size_t size = 0;
-    auto* data = static_cast<std::uint8_t*>(const_cast<void*>(arv_buffer_get_data(buffer, &size)));
-    const auto& geometry = sim_->config().renderer.geometry.camera;
-    const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-    if (pixel_format != ARV_PIXEL_FORMAT_MONO_8 || width != geometry.width ||
-        height != geometry.height || data == nullptr) {
-      ++mismatched_;
-      if (data != nullptr) std::memset(data, 0, std::min<std::size_t>(size, pixels));
-    } else if (!prerendered_.empty()) {
-      const auto& image = prerendered_[k % prerendered_.size()];
-      std::memcpy(data, image.data(), pixels);
-    } else {
-      const std::vector<std::uint8_t> image = render(k);
-      std::memcpy(data, image.data(), pixels);
-    }
-    arv_buffer_set_frame_id(buffer, frame_id(k));
-    const auto period_ns = static_cast<std::uint64_t>(1e9 / rate_hz_);
-    arv_buffer_set_timestamp(buffer, host_stamps_
-                                         ? static_cast<std::uint64_t>(g_get_real_time()) * 1000
-                                         : (k + 1) * period_ns);
-    ++filled_;
-  }
-
-  double rate_hz_;
-  double start_time_s_;
-  std::uint64_t first_id_;
-  bool host_stamps_;
-  std::set<std::uint64_t> drop_;
-  std::unique_ptr<sim::Simulator> sim_;
+  double rate_hz_ = 0;
+  double start_time_s_ = 0;
+  std::unique_ptr<sim::Simulator> sim_;  ///< the fake camera's thread only, once serving
   std::vector<std::vector<std::uint8_t>> prerendered_;
-  std::uint64_t next_ = 0;  ///< fake camera thread only
-  std::atomic<std::uint64_t> filled_{0};
-  std::atomic<std::uint64_t> skipped_{0};
-  std::atomic<std::uint64_t> mismatched_{0};
-  detail::GObjectPtr<ArvGvFakeCamera> fake_;  ///< last: stopped first
+  std::unique_ptr<SimGigECamera> camera_;  ///< last: stops serving before the rest goes
 };
 
 AVS_REGISTER_COMPONENT(SimCamera);
