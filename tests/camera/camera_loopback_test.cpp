@@ -18,11 +18,13 @@
 
 #include <gtest/gtest.h>
 
+#include "aravis_camera.hpp"
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/sim/scene.hpp"
 #include "avs/sim/simulator.hpp"
 #include "avs/testing/lockstep_graph.hpp"
+#include "sim_gige_camera.hpp"
 
 namespace avs::camera {
 namespace {
@@ -210,6 +212,74 @@ TEST(CameraLoopback, FramesDroppedOnPurposeAreCountedAndDepthResumes) {
   // Depth after the last gap.
   EXPECT_TRUE(std::any_of(checker->depth_k.begin(), checker->depth_k.end(),
                           [](std::int64_t k) { return k > 450 + 2 * 2 * kBits; }));
+}
+
+/// What AravisCamera says when the camera refuses a configuration: one line naming the
+/// feature, the value and what the camera allows.
+std::string configure_error(const CameraConfig& config) {
+  SimGigECamera served(SimGigECameraConfig{}, 512, 512, [](std::uint64_t, std::uint8_t* out) {
+    std::fill(out, out + 512 * 512, std::uint8_t{0});
+  });
+  try {
+    AravisCamera camera(config);
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+CameraConfig loopback_config() {
+  CameraConfig c;
+  c.device_id = "127.0.0.1";
+  c.trigger_mode = TriggerMode::kFreeRun;
+  c.frame_rate_hz = 200;
+  return c;
+}
+
+TEST(CameraLoopback, RejectedFeaturesAreOneLineNamingFeatureValueAndWhatIsAllowed) {
+  CameraConfig wide = loopback_config();
+  wide.width = 4000;
+  EXPECT_EQ(configure_error(wide),
+            "camera 127.0.0.1: Width = 4000 is out of range; the camera allows 1..2048");
+  CameraConfig source = loopback_config();
+  source.trigger_mode = TriggerMode::kHardware;
+  source.trigger_source = "Line7";
+  const std::string error = configure_error(source);
+  EXPECT_NE(error.find("camera 127.0.0.1: TriggerSource = Line7 rejected"), std::string::npos)
+      << error;
+  EXPECT_NE(error.find("the camera allows Line0, Software"), std::string::npos) << error;
+  CameraConfig fast = loopback_config();
+  fast.frame_rate_hz = 5000;
+  EXPECT_EQ(configure_error(fast),
+            "camera 127.0.0.1: AcquisitionFrameRate = 5000 is out of range; the camera allows "
+            "0.1..1000");
+  CameraConfig mono16 = loopback_config();
+  mono16.pixel_format = "Mono16";
+  EXPECT_EQ(configure_error(mono16),
+            "camera 127.0.0.1: PixelFormat = Mono16 is not supported by avs (decode takes "
+            "Mono8); the camera allows Mono8");
+  EXPECT_EQ(configure_error(loopback_config()), "(no error)");
+}
+
+TEST(CameraLoopback, UnknownDeviceListsTheCamerasFound) {
+  CameraConfig missing = loopback_config();
+  missing.device_id = "Nobody-NoCam-0000";
+  const std::string error = configure_error(missing);
+  EXPECT_NE(error.find("camera: cannot open 'Nobody-NoCam-0000'"), std::string::npos) << error;
+  EXPECT_NE(error.find("cameras found: "), std::string::npos) << error;
+}
+
+TEST(CameraLoopback, NoCameraAtAllIsOneClearLine) {
+  // No sim camera serving (this test holds the GVCP port lock): discovery finds nothing.
+  CameraConfig any = loopback_config();
+  any.device_id.clear();
+  std::string error = "(no error)";
+  try {
+    AravisCamera camera(any);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  EXPECT_EQ(error.rfind("camera: no GenICam camera found", 0), 0u) << error;
 }
 
 }  // namespace

@@ -200,6 +200,18 @@ TEST(PatternSequencer, DuplicatedFrameIsDropped) {
   EXPECT_EQ(o.stats.locks, 1);
 }
 
+TEST(PatternSequencer, LateFrameIsDroppedWithoutLosingTheLock) {
+  // A frame the transport completed after its successor (packets resent) comes in late.
+  std::vector<Delivery> s = stream(0, 10 * kFramesPerCycle);
+  std::swap(s[6 * kFramesPerCycle + 4], s[6 * kFramesPerCycle + 5]);
+  const Outcome o = run(s);
+  expect_true_labels(o);
+  EXPECT_EQ(o.stats.late_frames, 1);
+  EXPECT_EQ(o.stats.restarts, 0);
+  EXPECT_EQ(o.stats.lock_losses, 0);
+  EXPECT_EQ(o.stats.locks, 1);
+}
+
 TEST(PatternSequencer, FrameIdWrapIsContinuous) {
   // GigE Vision 16-bit block ids: ..., 65534, 65535, 1, 2, ... (0 is invalid).
   const Outcome o = run(stream(0, 10 * kFramesPerCycle, 65535 - 5 * kFramesPerCycle));

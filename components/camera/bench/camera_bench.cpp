@@ -83,12 +83,14 @@ bench::Report run(const std::vector<std::string>& args) {
   while (std::chrono::steady_clock::now() < end) {
     std::optional<CapturedFrame> f = camera.next(std::chrono::milliseconds(100));
     if (!f) continue;
-    if (last_id != 0) {
-      const std::uint64_t step = (f->frame_id + 65535 - last_id) % 65535;
-      if (step > 1) missing_ids += static_cast<std::int64_t>(step - 1);
+    if (f->frame_id != 0) {  // 0: no leader arrived, the id is unknown
+      const std::uint64_t step = last_id != 0 ? (f->frame_id + 65535 - last_id) % 65535 : 1;
+      if (step <= 32767) {  // larger: a late frame (completed after newer ones), not a gap
+        if (step > 1) missing_ids += static_cast<std::int64_t>(step - 1);
+        last_id = f->frame_id;
+      }
     }
-    last_id = f->frame_id;
-    if (!f->complete) {
+    if (!f->complete || f->frame_id == 0) {
       ++incomplete;
       continue;
     }

@@ -205,6 +205,7 @@ class CameraComponent final : public runtime::Component {
             {"missing_frame_ids", text(s.missing_ids)},
             {"gaps", text(s.gaps)},
             {"duplicates", text(s.duplicates)},
+            {"late_frames", text(s.late_frames)},
             {"restarts", text(s.restarts)},
             {"locks", text(s.locks)},
             {"lock_losses", text(s.lock_losses)},

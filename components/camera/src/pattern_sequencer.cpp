@@ -19,6 +19,8 @@ std::string_view to_string(DropReason reason) {
       return "not locked";
     case DropReason::kDuplicate:
       return "duplicate frame id";
+    case DropReason::kLate:
+      return "late frame (older id)";
     case DropReason::kUnpaired:
       return "pair partner lost";
     case DropReason::kVerifyFailed:
@@ -79,6 +81,14 @@ Released PatternSequencer::push(const CameraFrame& frame) {
     return out;
   }
   const std::int64_t dt_ns = frame.timestamp_ns - last_timestamp_ns_;
+  const double periods = static_cast<double>(dt_ns) * 1e-9 / config_.frame_period_s;
+  const bool consistent =
+      std::abs(periods - static_cast<double>(step)) <= config_.gap_tolerance_periods;
+  if (step < 0 && consistent && -step <= config_.max_bridged_gap_frames) {
+    ++stats_.late_frames;  // completed after newer frames: nothing to relabel
+    out.add(release(frame, DropReason::kLate));
+    return out;
+  }
   last_id_ = frame.frame_id;
   last_timestamp_ns_ = frame.timestamp_ns;
   if (step < 0 || dt_ns <= 0) {  // ids or clock went back: the camera restarted
@@ -89,9 +99,6 @@ Released PatternSequencer::push(const CameraFrame& frame) {
     hunt(frame, false, out);
     return out;
   }
-  const double periods = static_cast<double>(dt_ns) * 1e-9 / config_.frame_period_s;
-  const bool consistent =
-      std::abs(periods - static_cast<double>(step)) <= config_.gap_tolerance_periods;
   if (step > 1) stats_.missing_ids += step - 1;
   if (step != 1 || !consistent) ++stats_.gaps;
   position_ += consistent ? step : std::max<std::int64_t>(step, std::llround(periods)) + 1;
@@ -336,6 +343,7 @@ ReleasedFrame PatternSequencer::release(const CameraFrame& f, DropReason reason,
       ++stats_.dropped_unpaired;
       break;
     case DropReason::kDuplicate:
+    case DropReason::kLate:
     case DropReason::kVerifyFailed:
       break;  // counted where they are detected
   }

@@ -14,7 +14,9 @@
 //     trigger). A forward id gap whose timestamp step agrees (within gap_tolerance_periods)
 //     is bridged and counted; any other discontinuity (timestamp step > 1.5 periods for one
 //     id, ids going back or restarting, steps longer than max_bridged_gap_frames) drops the
-//     lock. A duplicated id is dropped. A positive is held until its negative: the pair is
+//     lock. A duplicated id is dropped, and so is a late one (an id at most
+//     max_bridged_gap_frames older than the last with a timestamp as much older: a frame the
+//     transport completed after newer ones). A positive is held until its negative: the pair is
 //     released only when its sum matches the previous pair's (the structure above), so a
 //     camera that slipped one exposure without a trace in its ids is caught before a frame
 //     of it is labelled.
@@ -80,6 +82,7 @@ enum class DropReason : std::uint8_t {
   kNone = 0,      ///< labelled
   kNotLocked,     ///< hunting for the cycle start
   kDuplicate,     ///< same frame id again
+  kLate,          ///< an older id than the last, its timestamp as much older (completed late)
   kUnpaired,      ///< its pair partner was lost (a lone frame cannot be verified or decoded)
   kVerifyFailed,  ///< the pair's structure did not match: lock dropped
   kFlushed,       ///< still held at flush()
@@ -107,6 +110,7 @@ struct SequencerStats {
   std::int64_t labelled = 0;  ///< released with a label
   std::int64_t dropped_not_locked = 0;
   std::int64_t duplicates = 0;
+  std::int64_t late_frames = 0;  ///< older ids arriving after newer ones; dropped
   std::int64_t dropped_unpaired = 0;
   std::int64_t verify_failures = 0;  ///< pairs whose structure did not match (lock dropped)
   std::int64_t missing_ids = 0;      ///< ids skipped by forward gaps
