@@ -7,24 +7,27 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # What the demo needs (runtime, components, `avs`, report figures; `avs view`: Boost.Beast
-# headers and nlohmann JSON).
+# headers and nlohmann JSON; the `camera` and `sim_camera` components: Aravis 0.8).
 DEMO_PACKAGES=(
   build-essential cmake pkg-config
   cyclonedds-dev cyclonedds-tools
   libeigen3-dev libyaml-cpp-dev libcli11-dev libnanoflann-dev
   libmodbus-dev libzstd-dev liblz4-dev zlib1g-dev libpng-dev
   libboost-dev nlohmann-json3-dev
+  libaravis-dev
   gnuplot-nox
 )
 # What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;
 # the MCAP fuzzer: clang; the independent MCAP reader: Node.js; the deployment tests: network
 # namespaces, openssl for DDS Security documents, iceoryx's RouDi for shared memory; the
-# `avs view` page test: Debian's chromium, driven headless).
+# `avs view` page test: Debian's chromium, driven headless; arv-tool-0.8 to look at cameras,
+# docs/devices.md).
 TEST_PACKAGES=(
   libopencv-dev libpcl-dev
   libgtest-dev libgmock-dev libbenchmark-dev chromium
   clang libclang-rt-14-dev nodejs
   iproute2 openssl python3 iceoryx
+  aravis-tools-cli
 )
 BUILD_DIR=${AVS_BUILD_DIR:-build}
 # The demo builds only the `avs` program, without tests and benchmarks, in its own folder, so

@@ -9,8 +9,10 @@
 
 namespace avs::testing {
 
-ContainerRun run_lockstep_container(const std::vector<std::string>& components, double duration_s,
-                                    int domain) {
+namespace {
+
+ContainerRun run_container(const std::vector<std::string>& components, const std::string& clock,
+                           int domain) {
   if (domain < 0) domain = test_domain();
   const auto file = std::filesystem::temp_directory_path() /
                     ("avs_lockstep_" + std::to_string(getpid()) + "_" + std::to_string(domain) +
@@ -18,7 +20,7 @@ ContainerRun run_lockstep_container(const std::vector<std::string>& components, 
   {
     std::ofstream out(file);
     out << "domain_id: " << domain << "\n"
-        << "clock: {source: sim, mode: lockstep, duration_s: " << duration_s << "}\n"
+        << "clock: " << clock << "\n"
         << "containers:\n"
         << "  - name: test\n"
         << "    executor: single_threaded\n"
@@ -34,6 +36,21 @@ ContainerRun run_lockstep_container(const std::vector<std::string>& components, 
   run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
   run.status = run.container->run();
   return run;
+}
+
+}  // namespace
+
+ContainerRun run_lockstep_container(const std::vector<std::string>& components, double duration_s,
+                                    int domain) {
+  return run_container(
+      components, "{source: sim, mode: lockstep, duration_s: " + std::to_string(duration_s) + "}",
+      domain);
+}
+
+ContainerRun run_wall_clock_container(const std::vector<std::string>& components, double duration_s,
+                                      int domain) {
+  return run_container(components, "{source: wall, duration_s: " + std::to_string(duration_s) + "}",
+                       domain);
 }
 
 }  // namespace avs::testing

@@ -32,4 +32,9 @@ struct ContainerRun {
 ContainerRun run_lockstep_container(const std::vector<std::string>& components, double duration_s,
                                     int domain = -1);
 
+/// The same on the wall clock, for `duration_s` of real time (components that talk to devices
+/// on their own threads, e.g. camera + sim_camera). Never assert speed with it.
+ContainerRun run_wall_clock_container(const std::vector<std::string>& components, double duration_s,
+                                      int domain = -1);
+
 }  // namespace avs::testing

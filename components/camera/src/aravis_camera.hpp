@@ -1,0 +1,74 @@
+// A GenICam camera through Aravis 0.8: open (by id or the only one found), configure the
+// features of CameraConfig with one-line errors, stream into a fixed pool of buffers. Frames
+// are lent: a CapturedFrame's lease returns its buffer to the stream when the last holder
+// drops it (no allocation and no copy per frame). No Aravis or glib types in this header.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "avs/camera/camera_config.hpp"
+
+namespace avs::camera {
+
+struct CapturedFrame {
+  const std::uint8_t* data = nullptr;  ///< Mono8, `stride` bytes per row
+  int width = 0;
+  int height = 0;
+  std::ptrdiff_t stride = 0;
+  std::size_t size = 0;  ///< bytes of image data
+  std::uint64_t frame_id = 0;
+  std::int64_t camera_timestamp_ns = 0;
+  std::int64_t host_timestamp_ns = 0;  ///< host realtime clock when the buffer completed
+  bool complete = false;
+  std::string status;                 ///< Aravis buffer status ("success", "missing packets", ...)
+  std::shared_ptr<const void> lease;  ///< keeps the buffer out of the pool while held
+};
+
+/// Aravis stream statistics (GigE Vision names; zero where the transport has none).
+struct StreamCounters {
+  std::uint64_t completed = 0;
+  std::uint64_t failures = 0;
+  std::uint64_t underruns = 0;  ///< a frame arrived while no buffer was free (back-pressure)
+  std::uint64_t timeouts = 0;
+  std::uint64_t missing_frames = 0;
+  std::uint64_t resent_packets = 0;
+  std::uint64_t missing_packets = 0;
+  std::uint64_t resend_requests = 0;
+};
+
+/// One line per camera Aravis sees: "<id> (<vendor> <model>, serial <s>, <address>)".
+std::vector<std::string> list_cameras();
+
+class AravisCamera {
+ public:
+  /// Opens and configures the camera; throws std::runtime_error with one line naming the
+  /// feature, the value and what the camera allows, or the cameras found.
+  explicit AravisCamera(const CameraConfig& config);
+  ~AravisCamera();
+  AravisCamera(const AravisCamera&) = delete;
+  AravisCamera& operator=(const AravisCamera&) = delete;
+
+  /// What was opened and set, for the start-up log.
+  const std::string& description() const;
+  bool is_gige() const;
+  /// What avs's own tests do not exercise on this camera's path (empty: the loopback GigE
+  /// Vision path of the tests), for a start-up warning.
+  std::string untested_path() const;
+
+  void start();
+  void stop();
+  /// The next buffer (complete or not), or nothing after `timeout`.
+  std::optional<CapturedFrame> next(std::chrono::milliseconds timeout);
+  StreamCounters counters() const;
+
+ private:
+  struct Impl;
+  std::shared_ptr<Impl> impl_;
+};
+
+}  // namespace avs::camera
