@@ -214,6 +214,9 @@ class LocalPublisher final : public PublisherCore {
     if (topic_.latched || topic_.writer->matched_readers() > 0) topic_.writer->write(sample.get());
   }
   const std::string& topic() const override { return topic_.dds_name; }
+  std::size_t reader_count() const override {
+    return topic_.subscriptions.size() + topic_.writer->matched_readers();
+  }
 
  private:
   Scheduler& scheduler_;
