@@ -1,10 +1,13 @@
 #include "avs/runtime/container.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <optional>
 
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/topic_name.hpp"
@@ -103,19 +106,73 @@ class ComponentHost final : public ComponentContext {
   bool uses_sim_time() const override { return container_.scheduler->mode() != TimeMode::wall; }
 
   TimerId create_timer(Duration period, std::function<void()> callback) override {
-    const TimerId id = container_.scheduler->add_timer(lane_, period, guard(std::move(callback)));
+    auto ticks = std::make_shared<std::atomic<std::uint64_t>>(0);
+    auto counted = [ticks, fn = std::move(callback)] {
+      ticks->fetch_add(1, std::memory_order_relaxed);
+      fn();
+    };
+    const TimerId id = container_.scheduler->add_timer(lane_, period, guard(std::move(counted)));
     std::lock_guard lock(timers_mutex_);
     timers_.push_back(id);
+    // The first window starts at the first tick.
+    timer_rates_.push_back({id, period, container_.scheduler->now() + period, ticks, 0, {}});
     return id;
   }
 
-  void cancel_timer(TimerId id) override { container_.scheduler->cancel_timer(id); }
+  void cancel_timer(TimerId id) override {
+    container_.scheduler->cancel_timer(id);
+    std::lock_guard lock(timers_mutex_);
+    std::erase_if(timer_rates_, [id](const TimerRate& t) { return t.id == id; });
+  }
 
   void cancel_all_timers() {
     std::lock_guard lock(timers_mutex_);
     for (TimerId id : timers_) container_.scheduler->cancel_timer(id);
     timers_.clear();
+    timer_rates_.clear();
   }
+
+  /// The slowest of this component's timers against its configured rate (diagnostics timer,
+  /// once a second): achieved and configured Hz, or nothing before any timer was measured. Each
+  /// timer is measured over windows of at least 100 of its periods (so that one tick more or
+  /// less is at most 1 %), the first from its first tick; a timer slower than 100 Hz is measured
+  /// over several reports.
+  struct TimerShortfall {
+    double achieved_hz = 0;
+    double configured_hz = 0;
+    bool below = false;  ///< achieved < 95 % of configured
+  };
+  std::optional<TimerShortfall> check_timer_rates(Time now) {
+    std::lock_guard lock(timers_mutex_);
+    std::optional<TimerShortfall> worst;
+    for (TimerRate& t : timer_rates_) {
+      const double configured_hz = 1e9 / static_cast<double>(t.period.count());
+      const double window_s = static_cast<double>((now - t.window_start).count()) * 1e-9;
+      if (window_s * configured_hz >= 100.0) {
+        const std::uint64_t ticks = t.ticks->load(std::memory_order_relaxed);
+        const auto n = static_cast<double>(ticks - t.window_ticks);
+        t.last = TimerShortfall{n / window_s, configured_hz, n < 0.95 * window_s * configured_hz};
+        t.window_start = now;
+        t.window_ticks = ticks;
+      }
+      if (t.last && (!worst || t.last->achieved_hz / t.last->configured_hz <
+                                   worst->achieved_hz / worst->configured_hz)) {
+        worst = t.last;
+      }
+    }
+    if (worst && worst->below) {
+      // Rate-limited: the first shortfall, then every 10th report that has one.
+      if (shortfalls_++ % 10 == 0) {
+        log_.warn("timer rate ", worst->achieved_hz, " Hz, below 95 % of its configured ",
+                  worst->configured_hz,
+                  " Hz (on the container's clock): this machine does not keep the graph's rate "
+                  "(warned every 10th second while it lasts)");
+      }
+    }
+    return worst;
+  }
+  /// The last check_timer_rates result (diagnostics timer only).
+  std::optional<TimerShortfall> last_timer_check;
 
   void set_active(bool active) { active_ = active; }
   const graph::ComponentInstance& instance() const { return instance_; }
@@ -194,8 +251,18 @@ class ComponentHost final : public ComponentContext {
   const int lane_;
   Logger log_;
   std::atomic<bool> active_{false};
+  struct TimerRate {
+    TimerId id;
+    Duration period;
+    Time window_start;                                  ///< of the current measuring window
+    std::shared_ptr<std::atomic<std::uint64_t>> ticks;  ///< callbacks run (while active)
+    std::uint64_t window_ticks;                         ///< `ticks` at window_start
+    std::optional<TimerShortfall> last;                 ///< the last complete window
+  };
   std::mutex timers_mutex_;
   std::vector<TimerId> timers_;
+  std::vector<TimerRate> timer_rates_;
+  std::uint64_t shortfalls_ = 0;
   std::mutex stats_mutex_;
   Stats stats_;
 };
@@ -214,6 +281,9 @@ class LocalPublisher final : public PublisherCore {
     if (topic_.latched || topic_.writer->matched_readers() > 0) topic_.writer->write(sample.get());
   }
   const std::string& topic() const override { return topic_.dds_name; }
+  std::size_t reader_count() const override {
+    return topic_.subscriptions.size() + topic_.writer->matched_readers();
+  }
 
  private:
   Scheduler& scheduler_;
@@ -274,9 +344,11 @@ void Container::Impl::fail(const std::string& what) {
 }
 
 void Container::Impl::publish_diagnostics(dds::Writer& writer) {
+  const Time now = scheduler->now();
+  // Timer rates are checked (and a shortfall warned) whether or not anyone reads /diagnostics.
+  for (auto& host : hosts) host->last_timer_check = host->check_timer_rates(now);
   if (writer.matched_readers() == 0) return;
   auto array = make_sample<msgs::diagnostic_msgs::DiagnosticArray>();
-  const Time now = scheduler->now();
   const double interval_s = (now - last_diagnostics).count() * 1e-9;
   last_diagnostics = now;
   to_ros_time(now, array->header.stamp);
@@ -302,11 +374,22 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
         {"callback_ms_max", std::to_string(stats.max_ms)}};
     constexpr std::size_t kOwn = std::size(values);
     std::vector<std::pair<std::string, std::string>> extra;
+    // The slowest timer against its configured rate (timer-driven components): WARN below 95 %.
+    if (const auto& timer = host.last_timer_check) {
+      extra.emplace_back("timer_rate_hz", std::to_string(timer->achieved_hz));
+      extra.emplace_back("timer_configured_hz", std::to_string(timer->configured_hz));
+      if (timer->below && !failed) {
+        status.level = 1;  // DiagnosticStatus WARN
+        set_string(status.message, "active, timer below 95 % of its configured rate (" +
+                                       std::to_string(timer->achieved_hz) + " of " +
+                                       std::to_string(timer->configured_hz) + " Hz)");
+      }
+    }
     if (host.component) {
       try {
-        extra = host.component->diagnostic_values();
+        for (auto& kv : host.component->diagnostic_values()) extra.push_back(std::move(kv));
       } catch (const std::exception& e) {
-        extra = {{"diagnostic_values_error", e.what()}};
+        extra.emplace_back("diagnostic_values_error", e.what());
       }
     }
     // Input rejected since the last report (SampleRejections' `rejected_samples`): WARN, so a

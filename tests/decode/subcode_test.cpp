@@ -1,11 +1,15 @@
 // Sub-code refinement (components/decode/src/subcode.hpp) on synthetic code staircases.
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <random>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "avs/decode/triangulation.hpp"
 #include "subcode.hpp"
 
 namespace avs::decode::detail {
@@ -103,6 +107,40 @@ TEST(SubcodeRefiner, RejectsBadParameters) {
   EXPECT_THROW(SubcodeRefiner({kWidth, kHeight, 0, 2}), std::invalid_argument);
   EXPECT_THROW(SubcodeRefiner({kWidth, kHeight, 17, 2}), std::invalid_argument);
   EXPECT_THROW(SubcodeRefiner({kWidth, kHeight, 4, -1}), std::invalid_argument);
+}
+
+// The AVX2 triangulation (8 pixels, plane rows loaded and transposed) equals the plain loop bit
+// for bit: codes across the table, between its planes, outside it, NaN; depths in and out of
+// the window.
+TEST(SubcodeTriangulation, InstructionSetsGiveBitIdenticalDepths) {
+  if (best_kernel_isa() != KernelIsa::kAvx2) GTEST_SKIP() << "this CPU has no AVX2";
+  const SensorGeometry g = default_sensor_geometry();
+  const DepthTable table(g, 16);
+  const int pixels = g.camera.width * g.camera.height;
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> code(-3.0f, static_cast<float>(g.layout.code_count) + 3);
+  std::vector<float> refined(static_cast<std::size_t>(pixels));
+  for (int i = 0; i < pixels; ++i) {
+    refined[static_cast<std::size_t>(i)] =
+        i % 17 == 0 ? std::numeric_limits<float>::quiet_NaN() : code(random);
+  }
+  const SubcodePlanes planes{table.subcode_planes(), table.subcode_steps(),
+                             table.subcode_plane_count()};
+  // Odd pixel counts leave a tail for the plain loop after the 8-pixel blocks.
+  for (const int n : {pixels, pixels - 5}) {
+    for (const auto& [min_m, max_m] : {std::pair{0.3f, 1.5f}, std::pair{0.9f, 1.1f}}) {
+      std::vector<float> plain(static_cast<std::size_t>(n)), avx2(static_cast<std::size_t>(n));
+      triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), min_m, max_m,
+                          plain.data(), n, KernelIsa::kScalar);
+      triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), min_m, max_m,
+                          avx2.data(), n, KernelIsa::kAvx2);
+      int finite = 0;
+      for (const float z : plain) finite += std::isfinite(z) ? 1 : 0;
+      EXPECT_GT(finite, 100) << "some codes fall in the table and the window";
+      EXPECT_EQ(std::memcmp(plain.data(), avx2.data(), plain.size() * sizeof(float)), 0)
+          << n << " pixels, window " << min_m << ".." << max_m << " m";
+    }
+  }
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "avs/runtime/container.hpp"
 #include "avs/runtime/dds.hpp"
 #include "avs/sim/simulator.hpp"
+#include "avs/testing/diagnostics.hpp"
 #include "avs/testing/lockstep_graph.hpp"
 #include "avs/testing/test_domain.hpp"
 
@@ -570,19 +571,11 @@ TEST(DecodeComponent, DropsAndTimingReachDiagnosticsOverDds) {
   const GraphRun run = run_graph(1.05, "{}", "{drop_frames: [100, 501]}");
   ASSERT_NE(run.recorder, nullptr);
   std::map<std::string, std::string> values;
-  for (;;) {
-    auto sample = runtime::make_sample<Array>();
-    void* buffers[1] = {sample.get()};
-    dds_sample_info_t info;
-    if (dds_take(reader.get(), buffers, &info, 1, 1) <= 0) break;
-    if (!info.valid_data) continue;
-    for (const auto& status : runtime::as_span(sample->status)) {
-      if (runtime::get_string(status.name) != "test/decode") continue;
-      for (const auto& kv : runtime::as_span(status.values)) {
-        values[std::string(runtime::get_string(kv.key))] = runtime::get_string(kv.value);
-      }
+  avs::testing::take_diagnostic_statuses(reader, "test/decode", [&](const auto& status) {
+    for (const auto& kv : runtime::as_span(status.values)) {
+      values[std::string(runtime::get_string(kv.key))] = runtime::get_string(kv.value);
     }
-  }
+  });
   ASSERT_FALSE(values.empty()) << "no /diagnostics status of test/decode received";
   EXPECT_EQ(values["dropped_frames"], "2");  // both drops happened before t = 1 s
   // Frame 100 is the positive of bit 5: its negative is an incomplete pair; frame 501 is the

@@ -50,17 +50,7 @@ struct BenchArgs {
 /// separately, so `--key value` may arrive out of order) or `--key value`.
 BenchArgs parse_args(const std::vector<std::string>& raw) {
   BenchArgs a;
-  std::vector<std::string> args;
-  for (const auto& w : raw) {
-    if (w == "--") continue;
-    const auto eq = w.find('=');
-    if (w.rfind("--", 0) == 0 && eq != std::string::npos) {
-      args.push_back(w.substr(0, eq));
-      args.push_back(w.substr(eq + 1));
-    } else {
-      args.push_back(w);
-    }
-  }
+  const std::vector<std::string> args = bench::option_words(raw);
   for (std::size_t i = 0; i < args.size(); ++i) {
     auto value = [&]() -> const std::string& {
       if (i + 1 >= args.size())

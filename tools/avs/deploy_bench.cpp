@@ -249,16 +249,7 @@ bench::Report transport_bench(const std::vector<std::string>& args) {
   PeerOptions o;
   o.count = 5000;
   // "--count=N" or "--count N" (avs bench passes unknown options on in any order).
-  std::vector<std::string> words;
-  for (const auto& a : args) {
-    const auto eq = a.find('=');
-    if (a.rfind("--", 0) == 0 && eq != std::string::npos) {
-      words.push_back(a.substr(0, eq));
-      words.push_back(a.substr(eq + 1));
-    } else {
-      words.push_back(a);
-    }
-  }
+  const std::vector<std::string> words = bench::option_words(args);
   for (std::size_t i = 0; i < words.size(); i += 2) {
     const std::string& key = words[i];
     if (i + 1 >= words.size() || (key != "--count" && key != "--rate" && key != "--bytes")) {

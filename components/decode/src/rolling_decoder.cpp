@@ -56,13 +56,34 @@ std::unique_ptr<detail::SubcodeRefiner> make_refiner(const DecoderConfig& c) {
                             c.subcode_half_window, c.subcode_max_jump});
 }
 
-/// Depth from fractional codes through the sub-code planes (NaN codes give NaN).
+/// Depth from fractional codes through the sub-code planes (NaN codes give NaN), all pixels.
 void triangulate_subcode(const DepthTable& table, const float* refined, const DecoderConfig& c,
                          float* depth_out) {
   detail::triangulate_subcode(
       refined, {table.subcode_planes(), table.subcode_steps(), table.subcode_plane_count()},
       table.ray_x(), table.ray_y(), c.min_depth_m, c.max_depth_m, depth_out, table.pixel_count());
 }
+
+/// The same one row at a time, as the refiner finishes each (the row still in the cache).
+class RowTriangulator final : public detail::SubcodeRefiner::RowSink {
+ public:
+  RowTriangulator(const DepthTable& table, const DecoderConfig& c, float* depth_out, int width)
+      : table_(table), c_(c), depth_out_(depth_out), width_(width) {}
+  void row_done(int y, const float* refined_row) override {
+    const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(y) * width_;
+    detail::triangulate_subcode(
+        refined_row,
+        {table_.subcode_planes(), table_.subcode_steps(), table_.subcode_plane_count()},
+        table_.ray_x() + offset, table_.ray_y() + offset, c_.min_depth_m, c_.max_depth_m,
+        depth_out_ + offset, width_);
+  }
+
+ private:
+  const DepthTable& table_;
+  const DecoderConfig& c_;
+  float* depth_out_;
+  int width_;
+};
 
 }  // namespace
 
@@ -265,8 +286,8 @@ void RollingDecoder::refine_depth(float* depth_out) {
   const auto full = static_cast<std::uint16_t>((1u << bit_count_) - 1u);
   detail::codes_from_gray(gray_.data(), valid_.data(), full, config_.geometry.layout.code_count,
                           codes_.data(), static_cast<int>(codes_.size()));
-  refiner_->refine(codes_.data(), refined_codes_.data());
-  triangulate_subcode(table_, refined_codes_.data(), config_, depth_out);
+  RowTriangulator triangulate_rows(table_, config_, depth_out, width_);
+  refiner_->refine(codes_.data(), refined_codes_.data(), &triangulate_rows);
 }
 
 void RollingDecoder::fill_point_map() {

@@ -1,5 +1,7 @@
 #include "rolling_kernel.hpp"
 
+#include "plane_lookup_avx2.hpp"
+
 #include <limits>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -139,9 +141,7 @@ void update_row_sse2(const std::uint8_t* __restrict positive,
 }
 
 // AVX2 (chosen at run time): the 16-bit steps on 16 pixels at once, then the depth of each
-// half: the plane look-up as 8 loads of (a, b, c, 0) (pixels i and i + 4 into the two lanes of
-// one register) and a 4x4 transpose per lane. Profiled on Zen 4, three hardware gathers took
-// over half of the loop; loads and shuffles give the same values in about half the time.
+// half through load_planes8 (plane_lookup_avx2.hpp).
 // kWithDepth = false: the bits only (while the window is incomplete).
 template <bool kWithDepth, bool kRowRay>
 __attribute__((target("avx2"))) void update_row_avx2(
@@ -162,24 +162,16 @@ __attribute__((target("avx2"))) void update_row_avx2(
   const __m256 zmax = _mm256_set1_ps(a.max_depth_m);
   const __m256 nan = _mm256_set1_ps(std::numeric_limits<float>::quiet_NaN());
   const float* planes = a.planes;
-  const auto plane = [planes](std::uint64_t word, int lane) {
-    return _mm_loadu_ps(planes + 4 * ((word >> (16 * lane)) & 0xffffu));
-  };
   // Depth of the 8 pixels from x on, with plane indices `index` (8 x 16 bit).
   const auto depth8 = [&](__m128i index, int x) __attribute__((target("avx2"))) {
     const auto lo = static_cast<std::uint64_t>(_mm_cvtsi128_si64(index));
     const auto hi = static_cast<std::uint64_t>(_mm_extract_epi64(index, 1));
-    const __m256 r04 = _mm256_insertf128_ps(_mm256_castps128_ps256(plane(lo, 0)), plane(hi, 0), 1);
-    const __m256 r15 = _mm256_insertf128_ps(_mm256_castps128_ps256(plane(lo, 1)), plane(hi, 1), 1);
-    const __m256 r26 = _mm256_insertf128_ps(_mm256_castps128_ps256(plane(lo, 2)), plane(hi, 2), 1);
-    const __m256 r37 = _mm256_insertf128_ps(_mm256_castps128_ps256(plane(lo, 3)), plane(hi, 3), 1);
-    const __m256 ab01 = _mm256_unpacklo_ps(r04, r15);  // a0 a1 b0 b1 | a4 a5 b4 b5
-    const __m256 ab23 = _mm256_unpacklo_ps(r26, r37);  // a2 a3 b2 b3 | a6 a7 b6 b7
-    const __m256 c01 = _mm256_unpackhi_ps(r04, r15);   // c0 c1 0 0 | c4 c5 0 0
-    const __m256 c23 = _mm256_unpackhi_ps(r26, r37);   // c2 c3 0 0 | c6 c7 0 0
-    const __m256 pa = _mm256_shuffle_ps(ab01, ab23, _MM_SHUFFLE(1, 0, 1, 0));
-    const __m256 pb = _mm256_shuffle_ps(ab01, ab23, _MM_SHUFFLE(3, 2, 3, 2));
-    const __m256 pc = _mm256_shuffle_ps(c01, c23, _MM_SHUFFLE(1, 0, 1, 0));
+    const float* rows[8];
+    for (int k = 0; k < 4; ++k) {
+      rows[k] = planes + 4 * ((lo >> (16 * k)) & 0xffffu);
+      rows[k + 4] = planes + 4 * ((hi >> (16 * k)) & 0xffffu);
+    }
+    const auto [pa, pb, pc] = load_planes8(rows);
     const __m256 ry = kRowRay ? _mm256_set1_ps(ray_y[0]) : _mm256_loadu_ps(ray_y + x);
     const __m256 den = _mm256_add_ps(
         _mm256_add_ps(_mm256_mul_ps(pa, _mm256_loadu_ps(ray_x + x)), _mm256_mul_ps(pb, ry)), pc);

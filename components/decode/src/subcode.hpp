@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "rolling_kernel.hpp"
+
 namespace avs::decode::detail {
 
 struct SubcodeParams {
@@ -25,8 +27,18 @@ class SubcodeRefiner {
  public:
   explicit SubcodeRefiner(SubcodeParams params);
 
+  /// Told each refined row as soon as it is final (rows in order 0 .. height - 1), so that the
+  /// next stage reads it while it is still in the cache.
+  class RowSink {
+   public:
+    virtual void row_done(int y, const float* refined_row) = 0;
+
+   protected:
+    ~RowSink() = default;
+  };
+
   /// codes: width * height, -1 where invalid. refined: width * height, NaN where invalid.
-  void refine(const std::int16_t* codes, float* refined);
+  void refine(const std::int16_t* codes, float* refined, RowSink* sink = nullptr);
 
   const SubcodeParams& params() const { return params_; }
 
@@ -51,9 +63,15 @@ struct SubcodePlanes {
 };
 
 /// Depth through the nearest sub-code plane of each fractional code (NaN codes, codes outside
-/// the table and depths outside (min, max) give NaN).
+/// the table and depths outside (min, max) give NaN), with the best instruction set of this
+/// CPU (best_kernel_isa()).
 void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
                          const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
                          int pixels);
+/// The same with instruction set `isa` (kAvx2 only where the CPU has it; kSse2 = kScalar here):
+/// every one gives bit-identical depths (tests/decode/subcode_test.cpp).
+void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
+                         const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
+                         int pixels, KernelIsa isa);
 
 }  // namespace avs::decode::detail

@@ -73,8 +73,17 @@ void KdTree::build(Points points) {
   if (!points_.empty()) index_ = std::make_unique<Index>(&points_);
 }
 
+void KdTree::rebuild(const Points& points) {
+  points_.assign(points.begin(), points.end());
+  if (!index_) {
+    index_ = std::make_unique<Index>(&points_);  // builds the index
+  } else {
+    index_->tree.buildIndex();
+  }
+}
+
 std::pair<std::uint32_t, float> KdTree::nearest(const Eigen::Vector3f& query) const {
-  if (!index_) throw std::logic_error("KdTree::nearest on an empty tree");
+  if (!index_ || points_.empty()) throw std::logic_error("KdTree::nearest on an empty tree");
   NearestResult result;
   index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
   return {result.index(), result.worstDist()};
@@ -82,7 +91,7 @@ std::pair<std::uint32_t, float> KdTree::nearest(const Eigen::Vector3f& query) co
 
 std::size_t KdTree::knn(const Eigen::Vector3f& query, std::size_t k, std::uint32_t* indices,
                         float* squared_distances) const {
-  if (!index_ || k == 0) return 0;
+  if (!index_ || points_.empty() || k == 0) return 0;
   nanoflann::KNNResultSet<float, std::uint32_t, std::size_t> result(k);
   result.init(indices, squared_distances);
   index_->tree.findNeighbors(result, query.data(), nanoflann::SearchParams());
@@ -92,7 +101,7 @@ std::size_t KdTree::knn(const Eigen::Vector3f& query, std::size_t k, std::uint32
 std::size_t KdTree::radius_search(const Eigen::Vector3f& query, float radius_m,
                                   std::vector<std::pair<std::uint32_t, float>>& out) const {
   out.clear();
-  if (!index_) return 0;
+  if (!index_ || points_.empty()) return 0;
   nanoflann::SearchParams params;
   params.sorted = false;
   return index_->tree.radiusSearch(query.data(), radius_m * radius_m, out, params);

@@ -15,7 +15,8 @@ bool usable(float z, const SceneCloudConfig& config) {
 }
 
 void remove_outliers_into(const Points& in, std::size_t neighbours, float threshold_m, Points& out,
-                          std::vector<std::uint32_t>& indices, std::vector<float>& squared) {
+                          KdTree& tree, std::vector<std::uint32_t>& indices,
+                          std::vector<float>& squared) {
   out.clear();
   if (in.size() <= 1 || neighbours == 0) {
     out = in;
@@ -25,7 +26,7 @@ void remove_outliers_into(const Points& in, std::size_t neighbours, float thresh
   // voxel step) 20 neighbours reach across the object and a thin part (its spike) would be taken
   // for outliers. Clouds of 240 points or more use `neighbours` as given.
   neighbours = std::min(neighbours, std::max<std::size_t>(4, in.size() / 12));
-  const KdTree tree(in);  // small (a few hundred points); the build is a few microseconds
+  tree.rebuild(in);  // small (a few hundred points); the build is a few microseconds
   indices.resize(neighbours + 1);
   squared.resize(neighbours + 1);
   for (const auto& p : in) {
@@ -111,16 +112,17 @@ const Points& SceneCloudBuilder::build(const DepthView& depth, const MaskView& m
 
   // 4. Outliers: mean distance to the k nearest neighbours above the threshold.
   remove_outliers_into(voxels_, config_.outlier_neighbours, config_.outlier_mean_distance_m,
-                       result_, knn_indices_, knn_squared_);
+                       result_, knn_tree_, knn_indices_, knn_squared_);
   return result_;
 }
 
 Points remove_outliers(const Points& points, std::size_t neighbours,
                        float mean_distance_threshold_m) {
   Points out;
+  KdTree tree;
   std::vector<std::uint32_t> indices;
   std::vector<float> squared;
-  remove_outliers_into(points, neighbours, mean_distance_threshold_m, out, indices, squared);
+  remove_outliers_into(points, neighbours, mean_distance_threshold_m, out, tree, indices, squared);
   return out;
 }
 

@@ -1,7 +1,9 @@
 // test_talker: publishes std_msgs/String "<seq> <address of this sample>" at a fixed rate,
 // and its sequence number as std_msgs/Float64 on a second port (a second type for tests).
 // Carrying its own address lets a listener prove it got the very same buffer (no copy).
+#include <chrono>
 #include <cstdio>
+#include <thread>
 
 #include "avs/runtime/component.hpp"
 
@@ -22,7 +24,10 @@ class TestTalker final : public runtime::Component {
                                           "messages to send, 0 = until stopped"),
                        ParamSpec::integer("fail_after", 0, 0, std::nullopt, "",
                                           "throw after this many messages (tests failure "
-                                          "reporting and respawn), 0 = never")},
+                                          "reporting and respawn), 0 = never"),
+                       ParamSpec::real("work_ms", 0.0, 0.0, 10000.0, "ms",
+                                       "sleep this long in every tick (a stage slowed on "
+                                       "purpose: the timer cannot keep rate_hz)")},
         .publishes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter"),
                       runtime::port<msgs::std_msgs::Float64>("count", "talker_count")},
         .subscribes = {}};
@@ -34,7 +39,8 @@ class TestTalker final : public runtime::Component {
         count_topic_(ctx.publisher<msgs::std_msgs::Float64>("count")),
         period_(static_cast<std::int64_t>(1e9 / ctx.param<double>("rate_hz"))),
         count_(ctx.param<std::int64_t>("count")),
-        fail_after_(ctx.param<std::int64_t>("fail_after")) {}
+        fail_after_(ctx.param<std::int64_t>("fail_after")),
+        work_(std::chrono::duration<double, std::milli>(ctx.param<double>("work_ms"))) {}
 
   void on_activate() override {
     timer_ = context().create_timer(period_, [this] { tick(); });
@@ -43,6 +49,7 @@ class TestTalker final : public runtime::Component {
 
  private:
   void tick() {
+    if (work_.count() > 0) std::this_thread::sleep_for(work_);
     if (count_ > 0 && seq_ >= static_cast<std::uint64_t>(count_)) return;
     if (fail_after_ > 0 && seq_ >= static_cast<std::uint64_t>(fail_after_)) {
       throw std::runtime_error("failing on purpose after " + std::to_string(seq_) + " messages");
@@ -64,6 +71,7 @@ class TestTalker final : public runtime::Component {
   runtime::Duration period_;
   std::int64_t count_;
   std::int64_t fail_after_;
+  std::chrono::duration<double, std::milli> work_;
   std::uint64_t seq_ = 0;
   runtime::TimerId timer_ = 0;
 };

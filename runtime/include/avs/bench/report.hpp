@@ -38,6 +38,24 @@ struct RegisteredBench {
 
 std::vector<RegisteredBench>& bench_registry();
 
+/// A benchmark's arguments as words, "--key=value" split into "--key" and "value" and a lone
+/// "--" dropped: `avs bench` hands unknown options over separately from positional words, so
+/// "--key value" may arrive out of order and benchmarks document "--key=value".
+inline std::vector<std::string> option_words(const std::vector<std::string>& args) {
+  std::vector<std::string> words;
+  for (const auto& w : args) {
+    if (w == "--") continue;
+    const auto eq = w.find('=');
+    if (w.rfind("--", 0) == 0 && eq != std::string::npos) {
+      words.push_back(w.substr(0, eq));
+      words.push_back(w.substr(eq + 1));
+    } else {
+      words.push_back(w);
+    }
+  }
+  return words;
+}
+
 inline bool register_bench(std::string name, std::string description, BenchFunction run) {
   bench_registry().push_back({std::move(name), std::move(description), std::move(run)});
   return true;

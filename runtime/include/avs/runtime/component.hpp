@@ -57,6 +57,9 @@ class PublisherCore {
   virtual ~PublisherCore() = default;
   virtual void publish(std::shared_ptr<const void> sample) = 0;
   virtual const std::string& topic() const = 0;
+  /// Readers now: subscriptions of this container's components plus matched readers of
+  /// other participants (a source that must not start before its receiver is there).
+  virtual std::size_t reader_count() const = 0;
 };
 
 /// Publishes samples of T: components in the same container get the same shared sample
@@ -68,6 +71,7 @@ class Publisher {
   explicit Publisher(std::shared_ptr<PublisherCore> core) : core_(std::move(core)) {}
   void publish(std::shared_ptr<const T> sample) const { core_->publish(std::move(sample)); }
   const std::string& topic() const { return core_->topic(); }
+  std::size_t reader_count() const { return core_->reader_count(); }
   explicit operator bool() const { return core_ != nullptr; }
 
  private:

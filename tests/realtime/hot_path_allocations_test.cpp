@@ -1,0 +1,236 @@
+// Issue 16 section 3: no heap allocation per frame after warm-up in the hot paths of decode,
+// tracking and matching. This test program's malloc counts while a section is armed; the simulator
+// renders the ken on the manipulator trajectory (head still) once, and 1000 frames (500 depth maps)
+// go through each core as the components run them: RollingDecoder (sub-code refinement on, as
+// launch_config/closed_loop.yaml), image moments + servo law, MatchingPipeline with the closed
+// loop's tuning.
+#include <atomic>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "avs/decode/rolling_decoder.hpp"
+#include "avs/matching/pipeline.hpp"
+#include "avs/sim/simulator.hpp"
+#include "avs/tracking/moments.hpp"
+#include "avs/tracking/tracker.hpp"
+
+namespace {
+
+std::atomic<bool> g_counting{false};
+std::atomic<long> g_allocations{0};
+
+void count() {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+}
+
+}  // namespace
+
+// Every heap allocation goes through malloc (operator new, std::vector, Eigen, nanoflann's
+// pool): glibc lets a program replace malloc, calloc, realloc and free (and uses them for
+// memalign & co.); these count and forward to glibc's own.
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void __libc_free(void*);
+void* malloc(std::size_t size) {
+  count();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  count();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  count();
+  return __libc_realloc(p, size);
+}
+void free(void* p) {
+  __libc_free(p);
+}
+}
+
+namespace avs {
+namespace {
+
+/// Counts the allocations made while it lives.
+class CountAllocations {
+ public:
+  CountAllocations() {
+    g_allocations = 0;
+    g_counting = true;
+  }
+  ~CountAllocations() { g_counting = false; }
+  CountAllocations(const CountAllocations&) = delete;
+  CountAllocations& operator=(const CountAllocations&) = delete;
+  long count() const { return g_allocations.load(); }
+};
+
+constexpr int kWarmUpFrames = 108;  // 6 cycles: every buffer has reached its working size
+constexpr int kCountedFrames = 1000;
+
+/// Two whole cycles of rendered frames of the ken on the manipulator trajectory, played
+/// forwards and backwards by cycle (as avs bench pipeline's pattern_replay).
+struct Recording {
+  sim::SimulatorConfig config;
+  std::vector<sim::SimFrame> frames;
+  int per_cycle = 18;
+
+  Recording() {
+    const matching::ObjectModel ken = matching::load_object_model("ken");
+    sim::Scene scene;
+    sim::SceneObject target;
+    target.name = "ken";
+    target.mesh = std::make_shared<const geometry::Mesh>(ken.mesh);
+    sim::ManipulatorMotionConfig motion;
+    target.trajectory = std::make_shared<sim::ManipulatorTrajectory>(motion);
+    scene.objects.push_back(target);
+    scene.objects.push_back(sim::make_background_plane(2.0));
+    sim::Simulator simulator(config, scene);
+    per_cycle = 2 * config.renderer.geometry.layout.bit_count;
+    for (int k = 0; k < 3 * per_cycle; ++k) {
+      frames.push_back(simulator.render(static_cast<std::uint64_t>(k), 0.5 + k * 1e-3, {}));
+    }
+  }
+
+  /// Frame k of the endless replay, its cycle counting up.
+  decode::PatternFrame frame(int k) const {
+    const int cycles = static_cast<int>(frames.size()) / per_cycle;
+    const int replay_cycle = k / per_cycle;
+    const int p = replay_cycle % (2 * (cycles - 1));
+    const int recorded = p < cycles ? p : 2 * (cycles - 1) - p;
+    const sim::SimFrame& f = frames[static_cast<std::size_t>(recorded * per_cycle + k % per_cycle)];
+    decode::PatternFrame input;
+    input.image = {f.image.pixels.data(), f.image.width, f.image.height, 0};
+    input.bit_index = f.pattern.bit_index;
+    input.polarity = f.pattern.positive ? decode::Polarity::kPositive : decode::Polarity::kNegative;
+    input.cycle = static_cast<std::uint32_t>(replay_cycle);
+    return input;
+  }
+};
+
+const Recording& recording() {
+  static const Recording r;
+  return r;
+}
+
+decode::DecoderConfig closed_loop_decoder() {
+  decode::DecoderConfig c;
+  c.geometry = recording().config.renderer.geometry;
+  c.subcode_half_window = 4;
+  return c;
+}
+
+/// Runs frames [begin, end) through the decoder; calls on_depth(depth) for each depth map.
+template <class OnDepth>
+int decode_frames(decode::RollingDecoder& decoder, std::vector<float>& depth, int begin, int end,
+                  OnDepth on_depth) {
+  int maps = 0;
+  for (int k = begin; k < end; ++k) {
+    const decode::PatternFrame f = recording().frame(k);
+    const decode::DecodeResult r = f.polarity == decode::Polarity::kNegative
+                                       ? decoder.push_frame(f, depth)
+                                       : decoder.push_frame(f);
+    if (r.depth_updated) {
+      ++maps;
+      on_depth();
+    }
+  }
+  return maps;
+}
+
+TEST(HotPathAllocations, DecodeWithSubcodeRefinement) {
+  decode::RollingDecoder decoder(closed_loop_decoder());
+  std::vector<float> depth(decoder.config().geometry.camera.width *
+                           decoder.config().geometry.camera.height);
+  decode_frames(decoder, depth, 0, kWarmUpFrames, [] {});
+  CountAllocations counter;
+  const int maps =
+      decode_frames(decoder, depth, kWarmUpFrames, kWarmUpFrames + kCountedFrames, [] {});
+  const long allocations = counter.count();
+  EXPECT_EQ(maps, kCountedFrames / 2);
+  EXPECT_EQ(allocations, 0) << "over " << kCountedFrames << " frames";
+}
+
+TEST(HotPathAllocations, TrackingMomentsAndServoLaw) {
+  decode::RollingDecoder decoder(closed_loop_decoder());
+  const geometry::CameraModel& camera = decoder.config().geometry.camera;
+  std::vector<float> depth(static_cast<std::size_t>(camera.width * camera.height));
+  const geometry::DepthView view{depth.data(), camera.width, camera.height, 0};
+  tracking::MomentsConfig moments;
+  tracking::Tracker tracker{tracking::TrackerConfig{}};
+  tracker.set_focal_lengths_px(camera.fx_px, camera.fy_px);
+  int present = 0;
+  const auto track = [&] {
+    const tracking::TargetObservation obs = tracking::measure_target(view, camera, moments);
+    present += obs.present ? 1 : 0;
+    (void)tracker.update(obs, tracking::JointState{});
+  };
+  decode_frames(decoder, depth, 0, kWarmUpFrames, track);
+  present = 0;
+  // Only the tracking calls are counted (decode is the test above).
+  long allocations = 0;
+  decode_frames(decoder, depth, kWarmUpFrames, kWarmUpFrames + kCountedFrames, [&] {
+    CountAllocations counter;
+    track();
+    allocations += counter.count();
+  });
+  EXPECT_GT(present, kCountedFrames / 4) << "the ken is in view";
+  EXPECT_EQ(allocations, 0) << "over " << kCountedFrames / 2 << " depth maps";
+}
+
+TEST(HotPathAllocations, MatchingClosedLoopTuning) {
+  decode::RollingDecoder decoder(closed_loop_decoder());
+  const geometry::CameraModel& camera = decoder.config().geometry.camera;
+  std::vector<float> depth(static_cast<std::size_t>(camera.width * camera.height));
+  const geometry::DepthView view{depth.data(), camera.width, camera.height, 0};
+  const matching::ObjectModel ken = matching::load_object_model("ken");
+  matching::ModelCloudConfig model_config;
+  model_config.target_points = ken.model_points;
+  matching::PipelineConfig config;  // launch_config/closed_loop.yaml's matching parameters
+  config.camera = camera;
+  config.tracker.dense_icp_model = true;
+  config.tracker.icp.max_correspondence_distance_m = 0.015F;
+  config.scene.target_points = 500;
+  config.scene.voxel_size_m = 0.005F;
+  config.scene.outlier_neighbours = 8;
+  config.tracker.icp.iterations = {0, 0, 2};
+  config.lag_compensation_s = 0.009;
+  config.velocity_window_s = 0.03;
+  config.tracker.icp.metric = ken.metric;
+  matching::MatchingPipeline pipeline(matching::make_model_cloud(ken.mesh, model_config), config);
+  int stamp = 0, poses = 0;
+  const auto match = [&] {
+    const matching::PipelineOutput out = pipeline.process(view, 1e-3 * stamp, 0.009);
+    stamp += 2;
+    poses += out.has_pose ? 1 : 0;
+  };
+  decode_frames(decoder, depth, 0, kWarmUpFrames, match);
+  poses = 0;
+  long allocations = 0;
+  long frames_allocating = 0;
+  decode_frames(decoder, depth, kWarmUpFrames, kWarmUpFrames + kCountedFrames, [&] {
+    CountAllocations counter;
+    match();
+    allocations += counter.count();
+    frames_allocating += counter.count() > 0 ? 1 : 0;
+  });
+  EXPECT_GT(poses, kCountedFrames / 4) << "the ken is tracked";
+  // NOT yet zero: the S-PCD outlier test rebuilds a kd-tree per frame (KdTree::rebuild, in place)
+  // and nanoflann 1.4's node pool frees and mallocs its 8 KiB block(s) on every build. Until a
+  // tree that keeps its nodes replaces it, this guards against anything more per frame.
+  std::printf(
+      "matching: %ld allocations over %d depth maps (%ld frames allocating): "
+      "nanoflann's node pool, issue 16 section 3 not met for matching\n",
+      allocations, kCountedFrames / 2, frames_allocating);
+  EXPECT_LE(allocations, 2L * (kCountedFrames / 2))
+      << "over " << kCountedFrames / 2 << " depth maps, " << frames_allocating
+      << " of them allocating";
+}
+
+}  // namespace
+}  // namespace avs
