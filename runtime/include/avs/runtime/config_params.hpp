@@ -143,6 +143,14 @@ class ConfigParams {
     return std::move(*this);
   }
 
+  /// Marks the parameter added last as dynamic (ParamSpec::dynamic): changeable while the
+  /// graph runs; the component re-makes its Config (make()) in on_parameters_changed.
+  ConfigParams&& live() && {
+    if (specs_.empty()) throw Error("ConfigParams::live() before any parameter");
+    specs_.back().dynamic = true;
+    return std::move(*this);
+  }
+
   const std::vector<ParamSpec>& specs() const { return specs_; }
 
   /// specs() followed by `more` (the component's own parameters, not the core's).
