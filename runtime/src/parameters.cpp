@@ -140,6 +140,10 @@ ParamSpec ParamSpec::live() && {
 }
 
 std::string format_number(double v) {
+  // Whole numbers as integers ("10000000", not "1e+07"), as a person writes them.
+  if (std::isfinite(v) && v == std::floor(v) && std::abs(v) < 1e15) {
+    return std::to_string(static_cast<long long>(v));
+  }
   char buf[64];
   auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
   if (ec != std::errc()) return std::to_string(v);

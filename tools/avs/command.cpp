@@ -7,6 +7,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "avs/runtime/parameters.hpp"
+
 namespace avs::cli {
 namespace {
 
@@ -41,7 +43,12 @@ Option* Option::check_member(std::vector<std::string> allowed) {
 }
 
 Option* Option::check_range(double min, double max) {
-  option_->check(CLI::Range(min, max));
+  // CLI11 describes a range as FLOAT even on an integer option ("INT:FLOAT in [0 - 232]"):
+  // the option's own type with the bounds instead, "INT in [0, 232]".
+  const std::string type = option_->get_type_name();
+  option_->check(CLI::Range(min, max).description(""));
+  option_->type_name(type + " in [" + runtime::format_number(min) + ", " +
+                     runtime::format_number(max) + "]");
   return this;
 }
 
@@ -56,6 +63,11 @@ Command::Command(std::string description)
 Command::Command(CLI::App* app) : app_(app) {}
 
 Command::~Command() = default;
+
+Command* Command::version(std::string text) {
+  app_->set_version_flag("--version", std::move(text));
+  return this;
+}
 
 Command* Command::add_subcommand(std::string name, std::string description) {
   // The constructor is private: no make_unique.

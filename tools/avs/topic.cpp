@@ -219,11 +219,14 @@ void run_list(const CommonOptions& o, bool verbose) {
     // Services (rq/..Request, rr/..Reply: the parameter services) are not topics, as in
     // `ros2 topic list`; `avs param list` shows the nodes that offer them.
     if (name.rfind("rq/", 0) == 0 || name.rfind("rr/", 0) == 0) continue;
-    std::printf("%-32s %-44s %zu pub, %zu sub\n", name.c_str(),
+    // ROS names (`/chatter`) as ros2 topic list prints them; the DDS ones with -v.
+    const std::string ros_name =
+        name.rfind("rt/", 0) == 0 ? runtime::from_dds_topic_name(name) : name;
+    std::printf("%-32s %-44s %zu pub, %zu sub\n", ros_name.c_str(),
                 runtime::to_ros_type_name(info.type_name).c_str(), info.publishers.size(),
                 info.subscribers.size());
     if (!verbose) continue;
-    std::printf("    DDS type: %s\n", info.type_name.c_str());
+    std::printf("    DDS topic: %s\n    DDS type: %s\n", name.c_str(), info.type_name.c_str());
     for (const auto& p : info.publishers) std::printf("    publisher:  %s\n", p.qos.c_str());
     for (const auto& s : info.subscribers) std::printf("    subscriber: %s\n", s.qos.c_str());
   }

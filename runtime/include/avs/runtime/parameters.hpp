@@ -22,7 +22,8 @@ std::string to_string(ParamType type);
 std::string to_string(const ParamValue& value);
 ParamType type_of(const ParamValue& value);
 
-/// Shortest text that reads back as the same double ("0.1", "10000", "1e-06").
+/// Shortest text that reads back as the same double ("0.1", "1e-06"); whole numbers as
+/// integers ("10000", "10000000").
 std::string format_number(double v);
 /// " in [0.1, 10000]", " >= 0", " <= 5" or "" (no bounds): the one way ranges are shown.
 std::string range_text(std::optional<double> min, std::optional<double> max);
