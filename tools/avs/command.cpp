@@ -4,10 +4,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
-
-#include "avs/runtime/parameters.hpp"
 
 namespace avs::cli {
 namespace {
@@ -23,6 +22,14 @@ CLI::Validator finite_number() {
         return std::isfinite(v) ? std::string() : "a finite number is needed, got " + text;
       },
       "", "FINITE");
+}
+
+/// A bound as a person writes it: "232", "0.1", "3600" (this file links nothing of avs).
+std::string bound_text(double v) {
+  std::ostringstream out;
+  out.precision(15);
+  out << v;
+  return out.str();
 }
 
 }  // namespace
@@ -47,8 +54,7 @@ Option* Option::check_range(double min, double max) {
   // the option's own type with the bounds instead, "INT in [0, 232]".
   const std::string type = option_->get_type_name();
   option_->check(CLI::Range(min, max).description(""));
-  option_->type_name(type + " in [" + runtime::format_number(min) + ", " +
-                     runtime::format_number(max) + "]");
+  option_->type_name(type + " in [" + bound_text(min) + ", " + bound_text(max) + "]");
   return this;
 }
 
