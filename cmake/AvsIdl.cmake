@@ -5,7 +5,8 @@
 # its DDS name (e.g. "sensor_msgs::msg::dds_::Image_"):
 #   - avs/msg/type_support.hpp : TypeSupport<CType> specialisations and C++ aliases
 #   - type_registry.cpp        : every struct's descriptor, and the IDL text itself
-# Our IDL files follow one convention (module <pkg> { module msg { module dds_ { ... }}}),
+# Our IDL files follow one convention (module <pkg> { module msg { module dds_ { ... }}}, or
+# module srv for the request/reply types of services, one kind per file),
 # which is what makes the regex scan below sufficient.
 find_program(AVS_IDLC idlc REQUIRED)
 
@@ -31,19 +32,20 @@ function(avs_idl_library)
     list(APPEND sources ${gen_dir}/${base}.c)
     string(APPEND includes "#include \"${base}.h\"\n")
     file(READ ${abs} text)
-    string(REGEX MATCH "module ([A-Za-z0-9_]+) *{ *module msg" _ "${text}")
+    string(REGEX MATCH "module ([A-Za-z0-9_]+) *{ *module (msg|srv)" _ "${text}")
     set(pkg ${CMAKE_MATCH_1})
+    set(kind ${CMAKE_MATCH_2})
     if(NOT pkg)
-      message(FATAL_ERROR "${idl}: expected 'module <pkg> { module msg { module dds_ {'")
+      message(FATAL_ERROR "${idl}: expected 'module <pkg> { module msg { module dds_ {' (or srv)")
     endif()
     string(REGEX MATCHALL "struct +[A-Za-z0-9_]+_ *{" structs "${text}")
     foreach(s ${structs})
       string(REGEX REPLACE "struct +([A-Za-z0-9_]+_) *{" "\\1" name "${s}")
       string(REGEX REPLACE "_$" "" short "${name}")
-      set(ctype "${pkg}_msg_dds__${name}")
-      string(APPEND traits "template <> struct TypeSupport<${ctype}> {\n  static const dds_topic_descriptor_t* descriptor() { return &${ctype}_desc; }\n  static constexpr const char* dds_name = \"${pkg}::msg::dds_::${name}\";\n};\n")
+      set(ctype "${pkg}_${kind}_dds__${name}")
+      string(APPEND traits "template <> struct TypeSupport<${ctype}> {\n  static const dds_topic_descriptor_t* descriptor() { return &${ctype}_desc; }\n  static constexpr const char* dds_name = \"${pkg}::${kind}::dds_::${name}\";\n};\n")
       string(APPEND aliases "namespace ${pkg} { using ${short} = ::${ctype}; }\n")
-      string(APPEND entries "    {\"${pkg}::msg::dds_::${name}\", &${ctype}_desc, sizeof(${ctype})},\n")
+      string(APPEND entries "    {\"${pkg}::${kind}::dds_::${name}\", &${ctype}_desc, sizeof(${ctype})},\n")
     endforeach()
     # Raw string delimiter chosen so IDL comments cannot end it.
     string(APPEND idl_texts "    {\"${base}.idl\", R\"avsidl(${text})avsidl\"},\n")

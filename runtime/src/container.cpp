@@ -10,8 +10,10 @@
 #include <optional>
 
 #include "avs/runtime/dds.hpp"
+#include "avs/runtime/ros_discovery.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "diagnostic_msgs.h"
+#include "parameter_service.hpp"
 #include "rosgraph_msgs.h"
 
 namespace avs::runtime {
@@ -37,14 +39,6 @@ struct TopicEntry {
   dds::Entity read_condition;
   std::vector<LocalSubscription> subscriptions;  // fixed once the container runs
 };
-
-/// A sample of any registered type, allocated for dds_take and freed with its descriptor.
-std::shared_ptr<void> allocate_sample(const msg::TypeEntry& type) {
-  const dds_topic_descriptor_t* descriptor = type.descriptor;
-  return std::shared_ptr<void>(dds_alloc(type.sample_size), [descriptor](void* p) {
-    dds_sample_free(p, descriptor, DDS_FREE_ALL);
-  });
-}
 
 }  // namespace
 
@@ -73,6 +67,8 @@ struct Container::Impl {
   std::vector<TopicEntry*> read_topics;  // waitset attach token = index
   TopicEntry* clock_follow = nullptr;
   Time last_diagnostics{};  ///< clock time of the previous /diagnostics report
+  std::unique_ptr<ParameterService> parameter_service;
+  std::unique_ptr<RosDiscoveryWriter> ros_discovery;
 };
 
 namespace {
@@ -88,8 +84,9 @@ TimeMode time_mode_for(const graph::Graph& g, const graph::ContainerSpec& s) {
 
 }  // namespace
 
-/// The ComponentContext a component sees: its parameters, ports, timers and clock.
-class ComponentHost final : public ComponentContext {
+/// The ComponentContext a component sees: its parameters, ports, timers and clock; and the
+/// node its parameter services answer for.
+class ComponentHost final : public ComponentContext, public ParameterNode {
  public:
   ComponentHost(Container::Impl& container, const graph::ComponentInstance& instance,
                 const RegisteredComponent& registered, int lane)
@@ -97,10 +94,36 @@ class ComponentHost final : public ComponentContext {
         instance_(instance),
         registered_(registered),
         lane_(lane),
-        log_(instance.name) {}
+        log_(instance.name),
+        node_name_(resolve_topic_name(container.graph.ns, instance.name)),
+        values_(instance.parameters) {}
 
   const std::string& name() const override { return instance_.name; }
-  const ParameterValues& parameters() const override { return instance_.parameters; }
+  /// Read on the component's thread, the one thread that changes them (apply_later).
+  const ParameterValues& parameters() const override { return values_; }
+
+  const std::string& node_name() const override { return node_name_; }
+  const ComponentSpec& node_spec() const override { return registered_.spec; }
+  ParameterValues snapshot() const override {
+    std::lock_guard lock(values_mutex_);
+    return values_;
+  }
+  void apply_later(ParameterValues values, std::vector<std::string> changed,
+                   std::function<void(const std::string&)> done) override {
+    container_.scheduler->post(lane_, [this, values = std::move(values),
+                                       changed = std::move(changed), done = std::move(done)] {
+      std::string refusal;
+      try {
+        if (!component) throw Error("the component is not running");
+        component->on_parameters_changed(values, changed);
+        std::lock_guard lock(values_mutex_);
+        values_ = values;
+      } catch (const std::exception& e) {
+        refusal = e.what();
+      }
+      done(refusal);
+    });
+  }
   const Logger& log() const override { return log_; }
   Time now() const override { return container_.scheduler->now(); }
   bool uses_sim_time() const override { return container_.scheduler->mode() != TimeMode::wall; }
@@ -177,6 +200,9 @@ class ComponentHost final : public ComponentContext {
   void set_active(bool active) { active_ = active; }
   const graph::ComponentInstance& instance() const { return instance_; }
   std::unique_ptr<Component> component;
+  /// The topics this component publishes and subscribes to (its node's writers and readers).
+  std::vector<const TopicEntry*> published;
+  std::vector<const TopicEntry*> subscribed;
 
  protected:
   std::shared_ptr<PublisherCore> make_publisher(std::string_view port,
@@ -250,6 +276,9 @@ class ComponentHost final : public ComponentContext {
   const RegisteredComponent& registered_;
   const int lane_;
   Logger log_;
+  const std::string node_name_;
+  mutable std::mutex values_mutex_;  ///< guards writes of values_ and reads off the lane
+  ParameterValues values_;
   std::atomic<bool> active_{false};
   struct TimerRate {
     TimerId id;
@@ -301,6 +330,7 @@ std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view po
     topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
     topic.latched = qos.durability == Durability::transient_local;
   }
+  published.push_back(&topic);
   return std::make_shared<LocalPublisher>(*container_.scheduler, topic);
 }
 
@@ -311,6 +341,7 @@ void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntr
   TopicEntry& topic = container_.topic(dds_name, type, qos);
   if (!topic.reader)
     topic.reader = std::make_unique<dds::Reader>(container_.participant, *topic.topic, qos);
+  subscribed.push_back(&topic);
   topic.subscriptions.push_back(
       {lane_, [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
          guard([&] { cb(std::move(sample)); })();
@@ -318,7 +349,10 @@ void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntr
 }
 
 Container::Impl::Impl(const graph::Graph& g, const graph::ContainerSpec& s)
-    : graph(g), spec(s), log("container/" + s.name), participant(g.domain_id, g.partition) {
+    : graph(g),
+      spec(s),
+      log("container/" + s.name),
+      participant(g.domain_id, g.partition, kRosParticipantUserData) {
   scheduler = std::make_unique<Scheduler>(time_mode_for(g, s), g.clock.real_time_factor);
 }
 
@@ -433,7 +467,7 @@ void Container::Impl::reader_loop() {
       TopicEntry& topic =
           *read_topics[static_cast<std::size_t>(triggered[static_cast<std::size_t>(i)] - 1)];
       for (;;) {
-        std::shared_ptr<void> sample = allocate_sample(*topic.type);
+        std::shared_ptr<void> sample = make_sample(topic.type->descriptor, topic.type->sample_size);
         void* buffers[1] = {sample.get()};
         dds_sample_info_t info;
         const dds_return_t taken = dds_take(topic.reader->get(), buffers, &info, 1, 1);
@@ -542,6 +576,32 @@ int Container::run() {
     c.waitset->attach(topic->read_condition.get(), static_cast<dds_attach_t>(c.read_topics.size()));
   }
 
+  // Parameters at run time: each component is a node with ROS 2's parameter services.
+  {
+    std::vector<ParameterNode*> nodes;
+    for (auto& host : c.hosts) nodes.push_back(host.get());
+    c.parameter_service = std::make_unique<ParameterService>(
+        c.participant, std::move(nodes), [&scheduler] { return scheduler.now(); });
+    c.parameter_service->start();
+  }
+
+  // ROS 2 nodes: each component, with its readers and writers, on ros_discovery_info.
+  {
+    std::vector<NodeEntities> nodes;
+    for (const auto& host : c.hosts) {
+      NodeEntities node{graph_.ns.empty() ? "/" : graph_.ns, host->instance().name, {}, {}};
+      for (const TopicEntry* t : host->subscribed) node.readers.push_back(gid_of(t->reader->get()));
+      for (const TopicEntry* t : host->published) node.writers.push_back(gid_of(t->writer->get()));
+      for (dds_entity_t e : c.parameter_service->readers_of(*host))
+        node.readers.push_back(gid_of(e));
+      for (dds_entity_t e : c.parameter_service->writers_of(*host))
+        node.writers.push_back(gid_of(e));
+      nodes.push_back(std::move(node));
+    }
+    c.ros_discovery = std::make_unique<RosDiscoveryWriter>(c.participant);
+    c.ros_discovery->publish(nodes);
+  }
+
   // Activate.
   c.running = true;
   for (auto& host : c.hosts) {
@@ -569,6 +629,7 @@ int Container::run() {
     scheduler.stop();
     c.waitset->wake();
     reader.join();
+    c.parameter_service->stop();
   }
 
   // Deactivate and shut down in reverse order; DDS entities go with the participant.

@@ -27,10 +27,21 @@ dds_domainid_t prepare_domain(dds_domainid_t domain) {
 
 }  // namespace
 
-Participant::Participant(dds_domainid_t domain, std::string partition)
-    : Entity(check_dds(dds_create_participant(prepare_domain(domain), nullptr, nullptr),
-                       "create DDS participant on domain " + std::to_string(domain))),
-      partition_(std::move(partition)) {}
+namespace {
+dds_entity_t create_participant(dds_domainid_t domain, const std::string& user_data) {
+  dds_qos_t* qos = nullptr;
+  if (!user_data.empty()) {
+    qos = dds_create_qos();
+    dds_qset_userdata(qos, user_data.data(), user_data.size());
+  }
+  const dds_entity_t p = dds_create_participant(prepare_domain(domain), qos, nullptr);
+  if (qos != nullptr) dds_delete_qos(qos);
+  return check_dds(p, "create DDS participant on domain " + std::to_string(domain));
+}
+}  // namespace
+
+Participant::Participant(dds_domainid_t domain, std::string partition, const std::string& user_data)
+    : Entity(create_participant(domain, user_data)), partition_(std::move(partition)) {}
 
 void Participant::apply_partition(dds_qos_t* qos) const {
   if (!partition_.empty()) dds_qset_partition1(qos, partition_.c_str());

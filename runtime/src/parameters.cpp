@@ -2,6 +2,7 @@
 // graph loader before anything starts.
 #include "avs/runtime/parameters.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 
@@ -30,6 +31,60 @@ std::string got_text(const ParamValue& value) {
   return to_string(value);
 }
 
+std::optional<double> parse_double(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  double v = 0.0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+std::optional<std::int64_t> parse_int(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  std::int64_t v = 0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (s.empty() || ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
+  return s;
+}
+
+/// "[1, 2.5]" (or "1, 2.5") as numbers; nullopt when an element is not one.
+std::optional<std::vector<double>> parse_list(std::string_view text) {
+  text = trim(text);
+  if (text.size() >= 2 && text.front() == '[' && text.back() == ']') {
+    text = trim(text.substr(1, text.size() - 2));
+  }
+  std::vector<double> values;
+  while (!text.empty()) {
+    const auto comma = text.find(',');
+    const auto item = trim(text.substr(0, comma));
+    const auto v = parse_double(item);
+    if (!v) return std::nullopt;
+    values.push_back(*v);
+    if (comma == std::string_view::npos) break;
+    text.remove_prefix(comma + 1);
+  }
+  return values;
+}
+
+/// Would YAML read `s` back as this very string (not a number, bool, null, list, ...)?
+bool plain_yaml_string(const std::string& s) {
+  if (s.empty() || s == "true" || s == "false" || s == "null" || s == "~") return false;
+  if (parse_double(s) || s.front() == ' ' || s.back() == ' ') return false;
+  for (const char c : s) {
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/' || c == '.' ||
+          c == '-' || c == ' ')) {
+      return false;
+    }
+  }
+  return s.front() != '-';
+}
+
 std::string join_quoted(const std::vector<std::string>& items) {
   std::string out;
   for (const auto& s : items) {
@@ -41,7 +96,54 @@ std::string join_quoted(const std::vector<std::string>& items) {
 
 }  // namespace
 
+ParamValue parse_param_text(ParamType type, std::string_view text) {
+  switch (type) {
+    case ParamType::boolean:  // only true/false: "yes", "on", "1" are typos more often than not
+      if (text == "true") return true;
+      if (text == "false") return false;
+      break;
+    case ParamType::integer:
+      if (auto i = parse_int(text)) return *i;
+      break;
+    case ParamType::real:
+      if (auto i = parse_int(text)) return static_cast<double>(*i);
+      if (auto d = parse_double(text)) return *d;
+      break;
+    case ParamType::real_list:
+      if (auto list = parse_list(text)) return std::move(*list);
+      break;
+    case ParamType::string:
+      break;
+  }
+  return std::string(text);
+}
+
+std::string to_yaml_text(const ParamValue& value) {
+  if (const auto* s = std::get_if<std::string>(&value)) {
+    if (plain_yaml_string(*s)) return *s;
+    std::string quoted = "'";
+    for (const char c : *s) quoted += c == '\'' ? std::string("''") : std::string(1, c);
+    return quoted + "'";
+  }
+  if (const auto* d = std::get_if<double>(&value)) {
+    // A whole number keeps its point so that YAML (and a reader of the file) sees a float.
+    std::string text = format_number(*d);
+    if (text.find_first_of(".eEni") == std::string::npos) text += ".0";
+    return text;
+  }
+  return to_string(value);
+}
+
+ParamSpec ParamSpec::live() && {
+  dynamic = true;
+  return std::move(*this);
+}
+
 std::string format_number(double v) {
+  // Whole numbers as integers ("10000000", not "1e+07"), as a person writes them.
+  if (std::isfinite(v) && v == std::floor(v) && std::abs(v) < 1e15) {
+    return std::to_string(static_cast<long long>(v));
+  }
   char buf[64];
   auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
   if (ec != std::errc()) return std::to_string(v);

@@ -19,6 +19,14 @@ const PortSpec* ComponentSpec::find_port(std::string_view name) const {
   return nullptr;
 }
 
+void Component::on_parameters_changed(const ParameterValues& /*values*/,
+                                      const std::vector<std::string>& changed) {
+  std::string names;
+  for (const auto& n : changed) names += (names.empty() ? "" : ", ") + n;
+  throw Error("not implemented: component '" + context_.name() +
+              "' declares dynamic parameters but does not apply changes (" + names + ")");
+}
+
 ComponentRegistry& ComponentRegistry::instance() {
   static ComponentRegistry registry;
   return registry;

@@ -25,10 +25,18 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
 #include "avs/runtime/dds.hpp"
+#include "avs/runtime/parameter_messages.hpp"
 #include "avs/sim/simulator.hpp"
 #include "avs/testing/diagnostics.hpp"
 #include "avs/testing/lockstep_graph.hpp"
 #include "avs/testing/test_domain.hpp"
+#ifdef AVS_PROGRAM
+#include <regex>
+#include <sstream>
+#include <thread>
+
+#include "avs_program.hpp"
+#endif
 
 namespace avs::decode {
 namespace {
@@ -40,20 +48,26 @@ using runtime::ParamSpec;
 constexpr int kBits = 9;
 constexpr int kFramesPerCycle = 2 * kBits;
 
-/// The scene both the source and the checks use: plane at 1.0 m, noise sigma 3, a shadow.
-const SyntheticScene& plane_scene() {
-  static const SyntheticScene scene = [] {
+/// The scene both the source and the checks use: plane at 1.0 m, noise sigma 3, a shadow. Low
+/// contrast (the projector adds 40 instead of 180, noise sigma 6): how many pixels pass Eq. 2
+/// then depends on psi (the run-time parameter test).
+const SyntheticScene& plane_scene(bool low_contrast = false) {
+  static const auto render = [](bool low) {
     PlaneSceneConfig c;
     c.plane_depth_m = 1.0;
-    c.noise_sigma = 3.0;
+    c.noise_sigma = low ? 6.0 : 3.0;
+    c.amplitude = low ? 40.0 : c.amplitude;
     c.seed = 2024;
     c.shadow_x0 = 200;
     c.shadow_x1 = 280;
     c.shadow_y0 = 150;
     c.shadow_y1 = 250;
     return render_plane(default_sensor_geometry(), c);
-  }();
-  return scene;
+  };
+  static const SyntheticScene scene = render(false);
+  if (!low_contrast) return scene;
+  static const SyntheticScene low = render(true);
+  return low;
 }
 
 /// What the recorder compares with: true depth, directly lit pixels, shadowed pixels.
@@ -63,17 +77,19 @@ struct Truth {
   std::vector<std::uint8_t> shadowed;  ///< a surface the projector does not light
 };
 
-const Truth& plane_truth() {
-  static const Truth truth = [] {
-    const SyntheticScene& scene = plane_scene();
+const Truth& plane_truth(bool low_contrast = false) {
+  static const auto make = [](const SyntheticScene& scene) {
     Truth t;
     t.depth_m = scene.true_depth_m;
     t.shadowed = scene.shadowed;
     t.lit.resize(scene.lit.size());
     for (std::size_t i = 0; i < t.lit.size(); ++i) t.lit[i] = scene.lit[i] && !scene.shadowed[i];
     return t;
-  }();
-  return truth;
+  };
+  static const Truth truth = make(plane_scene(false));
+  if (!low_contrast) return truth;
+  static const Truth low = make(plane_scene(true));
+  return low;
 }
 
 /// The truth the current test's source renders (set by the source before its first frame).
@@ -97,7 +113,9 @@ class TestPlanePatterns final : public runtime::Component {
             .description = "tests: Gray-code frames of a plane at 1 m, 1000 fps",
             .parameters = {ParamSpec::real_list("drop_frames", {}, "", "frame numbers never sent"),
                            ParamSpec::real_list("swap_frames", {}, "",
-                                                "frame numbers sent after the next one")},
+                                                "frame numbers sent after the next one"),
+                           ParamSpec::boolean("low_contrast", false,
+                                              "the projector adds 40, not 180; noise sigma 6")},
             .publishes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
                                                                       keep_last_4)},
             .subscribes = {}};
@@ -107,10 +125,11 @@ class TestPlanePatterns final : public runtime::Component {
       : Component(ctx),
         pattern_(ctx.publisher<msgs::avs_msgs::PatternFrame>("pattern")),
         drop_(as_set(ctx.param<std::vector<double>>("drop_frames"))),
-        swap_(as_set(ctx.param<std::vector<double>>("swap_frames"))) {}
+        swap_(as_set(ctx.param<std::vector<double>>("swap_frames"))),
+        low_contrast_(ctx.param<bool>("low_contrast")) {}
 
   void on_activate() override {
-    current_truth = &plane_truth();
+    current_truth = &plane_truth(low_contrast_);
     context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
   }
 
@@ -139,7 +158,7 @@ class TestPlanePatterns final : public runtime::Component {
 
   std::shared_ptr<const msgs::avs_msgs::PatternFrame> make_frame(std::int64_t f,
                                                                  runtime::Time now) {
-    const SyntheticScene& scene = plane_scene();
+    const SyntheticScene& scene = plane_scene(low_contrast_);
     auto m = runtime::make_sample<msgs::avs_msgs::PatternFrame>();
     runtime::to_ros_time(now, m->header.stamp);
     runtime::set_string(m->header.frame_id, "camera");
@@ -164,6 +183,7 @@ class TestPlanePatterns final : public runtime::Component {
   runtime::Publisher<msgs::avs_msgs::PatternFrame> pattern_;
   std::set<std::int64_t> drop_;
   std::set<std::int64_t> swap_;
+  bool low_contrast_;
   std::int64_t next_ = 0;
   std::shared_ptr<const msgs::avs_msgs::PatternFrame> held_;
 };
@@ -686,6 +706,128 @@ TEST(DecodeComponent, MalformedFramesFromAnotherProcessAreRejectedAndDepthGoesOn
     expect_accurate(run.recorder->depth[p], "pair " + std::to_string(p) + " beside the bad frames");
   }
 }
+
+#ifdef AVS_PROGRAM
+/// Issue 18 section 1: a running decode graph, `avs param set decode threshold_psi 30` from
+/// another process; the next depth maps use it (fewer valid pixels in the low-contrast scene),
+/// /parameter_events carries it, and refused changes say why.
+TEST(DecodeComponent, ThresholdSetFromAnotherProcessAppliesToTheNextDepthMaps) {
+  namespace rcl = msgs::rcl_interfaces;
+  runtime::dds::Participant participant(avs::testing::test_domain());
+  runtime::dds::Topic events_topic(participant, msg::TypeSupport<rcl::ParameterEvent>::descriptor(),
+                                   runtime::kParameterEventsTopic, runtime::parameter_events_qos());
+  runtime::dds::Reader events(participant, events_topic, runtime::parameter_events_qos());
+
+  avs::testing::BackgroundContainer graph(
+      {"{type: test_plane_patterns, name: source, parameters: {low_contrast: true}}",
+       "{type: decode, name: decode}", "{type: test_depth_recorder, name: recorder}"},
+      3600.0);
+  for (const auto& e : graph.run().load_errors) ADD_FAILURE() << e;
+  ASSERT_NE(graph.run().container, nullptr);
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("avs_param_test_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto out = dir / "out.txt";
+  const auto err = dir / "err.txt";
+  const auto avs = [&](std::vector<std::string> words) {
+    return avs::testing::run_avs(std::move(words), out, err);
+  };
+
+  // 1. The change, from another process, once the graph has run a while at psi 10.
+  while (graph.run().container->now().ns < 200'000'000) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(avs({"param", "set", "decode", "threshold_psi", "30"}), 0)
+      << avs::testing::read_file(err);
+  EXPECT_NE(avs::testing::read_file(out).find("/decode: threshold_psi = 30 (was 10)"),
+            std::string::npos)
+      << avs::testing::read_file(out);
+
+  // 2. /parameter_events carries it, stamped with the container's (sim) time of the change.
+  std::int64_t changed_at_ns = -1;
+  for (int attempt = 0; attempt < 500 && changed_at_ns < 0; ++attempt) {
+    auto event = runtime::make_sample<rcl::ParameterEvent>();
+    void* buffers[1] = {event.get()};
+    dds_sample_info_t info;
+    if (dds_take(events.get(), buffers, &info, 1, 1) > 0 && info.valid_data) {
+      EXPECT_EQ(runtime::get_string(event->node), "/decode");
+      ASSERT_EQ(event->changed_parameters._length, 1u);
+      EXPECT_EQ(runtime::get_string(event->changed_parameters._buffer[0].name), "threshold_psi");
+      EXPECT_EQ(event->changed_parameters._buffer[0].value.type, 2);  // PARAMETER_INTEGER
+      EXPECT_EQ(event->changed_parameters._buffer[0].value.integer_value, 30);
+      changed_at_ns = runtime::from_ros_time(event->stamp).ns;
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  ASSERT_GT(changed_at_ns, 0) << "no /parameter_events sample";
+
+  // 3. Refusals say why; reads show the value in force.
+  EXPECT_EQ(avs({"param", "set", "decode", "threshold_psi", "300"}), 1);
+  EXPECT_NE(avs::testing::read_file(err).find("expected an integer in [0, 255], got 300"),
+            std::string::npos)
+      << avs::testing::read_file(err);
+  EXPECT_EQ(avs({"param", "set", "decode", "bit_count", "8"}), 1);
+  EXPECT_NE(avs::testing::read_file(err).find("bit_count is not dynamic"), std::string::npos)
+      << avs::testing::read_file(err);
+  EXPECT_EQ(avs({"param", "set", "decode", "no_such_threshold", "1"}), 1);
+  EXPECT_NE(avs::testing::read_file(err).find("unknown parameter 'no_such_threshold'"),
+            std::string::npos)
+      << avs::testing::read_file(err);
+  EXPECT_EQ(avs({"param", "get", "decode", "threshold_psi"}), 0) << avs::testing::read_file(err);
+  EXPECT_EQ(avs::testing::read_file(out), "30\n");
+  EXPECT_EQ(avs({"param", "list", "decode"}), 0) << avs::testing::read_file(err);
+  const std::string list = avs::testing::read_file(out);
+  EXPECT_TRUE(std::regex_search(list, std::regex("\n  threshold_psi +integer, dynamic\n"))) << list;
+  EXPECT_TRUE(std::regex_search(list, std::regex("\n  bit_count +integer, restart\n"))) << list;
+  EXPECT_EQ(avs({"param", "dump", "decode"}), 0) << avs::testing::read_file(err);
+  const std::string dump = avs::testing::read_file(out);
+
+  // 4. Enough depth maps after the change: a whole cycle (every bit binarised with psi 30).
+  constexpr std::int64_t kCycleNs = 2'000'000LL * kBits;
+  while (graph.run().container->now().ns < changed_at_ns + 10 * kCycleNs) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(graph.stop(), 0);
+  const auto* recorder = graph.run().find<TestDepthRecorder>("recorder");
+  ASSERT_NE(recorder, nullptr);
+  double before = 0, after = 0;
+  int before_n = 0, after_n = 0;
+  for (const DepthRecord& r : recorder->depth) {
+    if (r.stamp_ns >= changed_at_ns - 10 * kCycleNs && r.stamp_ns < changed_at_ns - 2'000'000) {
+      before += static_cast<double>(r.valid);
+      ++before_n;
+    } else if (r.stamp_ns > changed_at_ns + kCycleNs) {
+      after += static_cast<double>(r.valid);
+      ++after_n;
+    }
+  }
+  ASSERT_GT(before_n, 0);
+  ASSERT_GT(after_n, 0);
+  before /= before_n;
+  after /= after_n;
+  std::printf("valid pixels per depth map: %.0f at psi 10 (%d maps), %.0f at psi 30 (%d maps)\n",
+              before, before_n, after, after_n);
+  EXPECT_LT(after, 0.8 * before);
+
+  // 5. The dump is a `parameters:` block the graph loader takes, with the value in force.
+  const auto file = dir / "dumped.yaml";
+  {
+    std::ofstream yaml(file);
+    yaml << "containers:\n  - name: c\n    components:\n      - type: decode\n        name: d\n"
+         << "        parameters:\n";
+    std::istringstream lines(dump);
+    for (std::string line; std::getline(lines, line);) yaml << "          " << line << "\n";
+  }
+  const graph::LoadResult loaded = graph::load_graph(file.string(), {});
+  for (const auto& e : loaded.errors) ADD_FAILURE() << e.str() << "\n" << dump;
+  ASSERT_TRUE(loaded.ok());
+  EXPECT_EQ(loaded.graph->containers.front().components.front().parameters.get<std::int64_t>(
+                "threshold_psi"),
+            30);
+  std::filesystem::remove_all(dir);
+}
+#endif  // AVS_PROGRAM
 
 }  // namespace
 }  // namespace avs::decode

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `avs topic list/echo/hz` from another process against a running graph, then Ctrl-C
+# `avs topic list/info/type/echo/hz` from another process against a running graph, then Ctrl-C
 # (SIGINT) to `avs launch` must stop every container cleanly.
 set -euo pipefail
 avs=$1; src=$2
@@ -11,9 +11,21 @@ trap 'kill $launcher 2>/dev/null || true; rm -rf "$out"' EXIT
 
 "$avs" topic list -v --wait 3 > "$out/list"
 cat "$out/list"
-grep -q "^rt/chatter .*std_msgs/msg/String .*1 pub, 2 sub" "$out/list" || fail "topic list lacks rt/chatter"
+grep -q "^/chatter .*std_msgs/msg/String .*1 pub, 2 sub" "$out/list" || fail "topic list lacks /chatter"
+grep -q "DDS topic: rt/chatter" "$out/list" || fail "topic list -v lacks the DDS topic name"
+if grep -q "^r[qr]/" "$out/list"; then fail "topic list shows the parameter services"; fi
 grep -q "DDS type: std_msgs::msg::dds_::String_" "$out/list" || fail "topic list -v lacks the DDS type"
 grep -q "publisher:  reliable, volatile, keep_last 10" "$out/list" || fail "topic list -v lacks QoS"
+
+# topic type / info (issue 18 section 2), ROS names as `ros2 topic` prints them.
+[ "$("$avs" topic type /chatter)" = "std_msgs/msg/String" ] || fail "topic type /chatter"
+"$avs" topic info chatter -v > "$out/info"
+cat "$out/info"
+grep -q "^Type: std_msgs/msg/String$" "$out/info" || fail "topic info lacks the type"
+grep -q "^Publisher count: 1$" "$out/info" || fail "topic info: publisher count"
+grep -q "^Subscription count: 2$" "$out/info" || fail "topic info: subscription count"
+grep -q "^  QoS: reliable, volatile, keep_last 10$" "$out/info" || fail "topic info -v lacks QoS"
+"$avs" --version | grep -q "^avs [0-9]*\.[0-9]*\.[0-9]*$" || fail "avs --version"
 
 "$avs" topic echo /chatter -n 3 > "$out/echo"
 cat "$out/echo"

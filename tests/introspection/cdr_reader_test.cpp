@@ -11,13 +11,9 @@
 namespace avs::introspection {
 namespace {
 
+using test::serializer;
 using test::text;
 using test::view;
-
-test::CycloneSerializer& serializer() {
-  static test::CycloneSerializer instance;
-  return instance;
-}
 
 std_msgs_msg_dds__Header_ make_header(std::int32_t sec, std::uint32_t nanosec,
                                       const char* frame_id) {

@@ -68,6 +68,12 @@ class CycloneSerializer {
   int topic_count_ = 0;
 };
 
+/// The one serialiser of a test program (one participant for all its cases).
+inline CycloneSerializer& serializer() {
+  static CycloneSerializer instance;
+  return instance;
+}
+
 /// A C sequence viewing `values` (Cyclone only reads it while serialising).
 template <class Sequence, class Element>
 Sequence view(std::vector<Element>& values) {

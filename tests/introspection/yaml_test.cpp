@@ -10,13 +10,9 @@
 namespace avs::introspection {
 namespace {
 
+using test::serializer;
 using test::text;
 using test::view;
-
-test::CycloneSerializer& serializer() {
-  static test::CycloneSerializer instance;
-  return instance;
-}
 
 TEST(Yaml, JointStateLikeRos2TopicEcho) {
   std::vector<char*> names = {text("pan"), text("tilt: 2"), text("")};

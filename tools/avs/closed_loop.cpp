@@ -82,12 +82,15 @@ int choose_closed_loop_domain(const ClosedLoopRun& run, std::ostream& progress) 
   // The run is private unless asked otherwise: samples of another system on the same DDS
   // domain (a second demo, a test) would reach these components and break the lockstep
   // run's determinism. AVS_DOMAIN_ID=N shares the run with `avs topic` & co. on domain N.
-  if (const auto domain = environment_domain()) return *domain;
-  const int domain = 200 + getpid() % 32;
+  const auto given = environment_domain();
+  const int domain = given ? *given : 200 + getpid() % 32;
   static bool said = false;
   if (!said) {
+    // The one command that watches the run from a second shell, domain included.
     progress << "[" << run.scenario << "] DDS domain " << domain
-             << " (private to this run; set AVS_DOMAIN_ID to watch it with avs topic)\n";
+             << (given ? " ($AVS_DOMAIN_ID)" : " (private to this run)")
+             << "; watch it with: avs graph --domain " << domain << "  (or AVS_DOMAIN_ID=" << domain
+             << " avs topic list, avs param list, ...)\n";
     said = true;
   }
   return domain;

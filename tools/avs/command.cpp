@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <sstream>
 
 #include <CLI/CLI.hpp>
 
@@ -21,6 +22,14 @@ CLI::Validator finite_number() {
         return std::isfinite(v) ? std::string() : "a finite number is needed, got " + text;
       },
       "", "FINITE");
+}
+
+/// A bound as a person writes it: "232", "0.1", "3600" (this file links nothing of avs).
+std::string bound_text(double v) {
+  std::ostringstream out;
+  out.precision(15);
+  out << v;
+  return out.str();
 }
 
 }  // namespace
@@ -41,7 +50,11 @@ Option* Option::check_member(std::vector<std::string> allowed) {
 }
 
 Option* Option::check_range(double min, double max) {
-  option_->check(CLI::Range(min, max));
+  // CLI11 describes a range as FLOAT even on an integer option ("INT:FLOAT in [0 - 232]"):
+  // the option's own type with the bounds instead, "INT in [0, 232]".
+  const std::string type = option_->get_type_name();
+  option_->check(CLI::Range(min, max).description(""));
+  option_->type_name(type + " in [" + bound_text(min) + ", " + bound_text(max) + "]");
   return this;
 }
 
@@ -56,6 +69,11 @@ Command::Command(std::string description)
 Command::Command(CLI::App* app) : app_(app) {}
 
 Command::~Command() = default;
+
+Command* Command::version(std::string text) {
+  app_->set_version_flag("--version", std::move(text));
+  return this;
+}
 
 Command* Command::add_subcommand(std::string name, std::string description) {
   // The constructor is private: no make_unique.

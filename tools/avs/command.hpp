@@ -52,6 +52,8 @@ class Command {
   Command& operator=(Command&&) = delete;
 
   Command* add_subcommand(std::string name, std::string description);
+  /// `--version` prints `text` and exits.
+  Command* version(std::string text);
 
   Option* add_option(std::string name, std::string& value, std::string description = "");
   Option* add_option(std::string name, std::vector<std::string>& values,

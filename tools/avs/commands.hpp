@@ -15,6 +15,8 @@ void add_container_command(Command& app);
 void add_check_command(Command& app);
 void add_components_command(Command& app);
 void add_topic_command(Command& app);
+/// `avs topic pub` (topic_pub.cpp), added by add_topic_command.
+void add_topic_pub_command(Command* topic);
 void add_bench_command(Command& app);
 void add_demo_command(Command& app);
 

@@ -149,7 +149,7 @@ std::vector<std::string> mismatch(const Endpoint& pub, const Endpoint& sub) {
 struct Options {
   int domain = 0;  // add_domain_option
   double duration_s = 3.0;
-  bool rates = true;
+  bool no_rates = false;  // --no-rates
 };
 
 int run_graph_view(const Options& o) {
@@ -258,7 +258,7 @@ int run_graph_view(const Options& o) {
     take_endpoints(pubs.get(), true);
     take_endpoints(subs.get(), false);
     take_diagnostics();
-    if (o.rates && rate_start == Clock::time_point{} && Clock::now() >= discover_until) {
+    if (!o.no_rates && rate_start == Clock::time_point{} && Clock::now() >= discover_until) {
       for (const auto& [key, e] : endpoints) {
         if (key.back() != 'w' || counters.count(e.topic)) continue;
         const msg::TypeEntry* t = msg::find_type(e.type);
@@ -317,6 +317,9 @@ int run_graph_view(const Options& o) {
   std::set<std::string> topics;
   for (const auto& [key, e] : endpoints) {
     if (e.topic.rfind("DCPS", 0) == 0) continue;
+    // Services (the parameter services' rq/..Request, rr/..Reply) are not topics; `avs node
+    // info` lists them.
+    if (e.topic.rfind("rq/", 0) == 0 || e.topic.rfind("rr/", 0) == 0) continue;
     topics.insert(e.topic);
     (key.back() == 'w' ? by_topic_pub : by_topic_sub)[e.topic].push_back(&e);
   }
@@ -349,6 +352,9 @@ int run_graph_view(const Options& o) {
     const std::string ros = t.rfind("rt/", 0) == 0 ? t.substr(2) : t;
     for (const auto* s : by_topic_sub[t]) {
       for (const auto* p : by_topic_pub[t]) {
+        // One participant is one container: its components get each other's samples in
+        // process, whatever the QoS, and its DDS readers ignore its own writers.
+        if (p->participant == s->participant) continue;
         for (const auto& why : mismatch(*p, *s)) {
           ++problems;
           std::cout << "  " << ros << ": publisher " << who(p->participant) << " and subscriber "
@@ -371,7 +377,7 @@ void add_graph_command(Command& app) {
                   "seconds to observe (rates are measured in the second half)")
       ->capture_default_str()
       ->check_range(0.1, 3600);
-  cmd->add_flag("!--no-rates", o.rates, "do not subscribe to topics to measure rates");
+  cmd->add_flag("--no-rates", o.no_rates, "do not subscribe to topics to measure rates");
   cmd->footer(
       "Exit status 3 when a publisher and a subscriber of one topic cannot match.\n"
       "On a deployment: eval \"$(avs deploy env DEPLOY.yaml --host H)\"; avs graph");

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
       "avs: active high-speed 3-D vision (Gray-code depth at 500 Hz, visual servoing, "
       "model matching) as a graph of components over DDS"};
   app.require_subcommand(1);
+  app.version("avs " AVS_VERSION);
   avs::cli::add_demo_command(app);
   avs::cli::add_launch_command(app);
   avs::cli::add_check_command(app);

@@ -17,6 +17,7 @@
 
 #include "avs/deploy/deployment.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 
 namespace avs::cli {
@@ -131,8 +132,14 @@ std::vector<Grant> grants_of(const deploy::Deployment& d) {
   std::vector<Grant> out;
   const auto& registry = runtime::ComponentRegistry::instance();
   for (const auto& c : d.graph.containers) {
-    Grant g{c.name, {"rt/diagnostics", "rt/clock"}, {"rt/clock"}};
+    Grant g{c.name,
+            {"rt/diagnostics", "rt/clock", "rt/parameter_events", "ros_discovery_info"},
+            {"rt/clock"}};
     for (const auto& comp : c.components) {
+      // Each component is a ROS 2 node answering its parameter services (docs/operate.md).
+      const std::string node = runtime::resolve_topic_name(d.graph.ns, comp.name);
+      g.publish.insert("rr" + node + "/*");
+      g.subscribe.insert("rq" + node + "/*");
       const runtime::RegisteredComponent* reg = registry.find(comp.type);
       if (reg == nullptr) continue;
       for (const auto& p : reg->spec.publishes)

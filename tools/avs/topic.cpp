@@ -17,6 +17,7 @@
 #include "avs/introspection/type_database.hpp"
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/dds.hpp"
+#include "avs/runtime/parameters.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
@@ -215,15 +216,54 @@ void run_list(const CommonOptions& o, bool verbose) {
   const auto topics =
       discover(participant, std::chrono::milliseconds(static_cast<int>(o.wait_s * 1000)));
   for (const auto& [name, info] : topics) {
-    std::printf("%-32s %-44s %zu pub, %zu sub\n", name.c_str(),
+    // Services (rq/..Request, rr/..Reply: the parameter services) are not topics, as in
+    // `ros2 topic list`; `avs param list` shows the nodes that offer them.
+    if (name.rfind("rq/", 0) == 0 || name.rfind("rr/", 0) == 0) continue;
+    // ROS names (`/chatter`) as ros2 topic list prints them; the DDS ones with -v.
+    const std::string ros_name =
+        name.rfind("rt/", 0) == 0 ? runtime::from_dds_topic_name(name) : name;
+    std::printf("%-32s %-44s %zu pub, %zu sub\n", ros_name.c_str(),
                 runtime::to_ros_type_name(info.type_name).c_str(), info.publishers.size(),
                 info.subscribers.size());
     if (!verbose) continue;
-    std::printf("    DDS type: %s\n", info.type_name.c_str());
+    std::printf("    DDS topic: %s\n    DDS type: %s\n", name.c_str(), info.type_name.c_str());
     for (const auto& p : info.publishers) std::printf("    publisher:  %s\n", p.qos.c_str());
     for (const auto& s : info.subscribers) std::printf("    subscriber: %s\n", s.qos.c_str());
   }
   if (topics.empty()) std::fprintf(stderr, "no topics found on domain %d\n", o.domain);
+}
+
+/// The publishers and subscribers of o.topic, waiting up to o.wait_s for the first one.
+TopicInfo find_topic(const runtime::dds::Participant& participant, const CommonOptions& o) {
+  const std::string dds_name = dds_topic_of(o.topic);
+  const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_s);
+  for (;;) {
+    const auto topics = discover(participant, std::chrono::milliseconds(300));
+    if (const auto it = topics.find(dds_name); it != topics.end()) return it->second;
+    if (Clock::now() > deadline) {
+      throw runtime::Error("no publisher or subscriber of " +
+                           runtime::from_dds_topic_name(dds_name) + " on domain " +
+                           std::to_string(o.domain) + " within " +
+                           runtime::format_number(o.wait_s) + " s (--wait)");
+    }
+  }
+}
+
+/// As `ros2 topic info [-v]`: the type, the endpoint counts, with -v each endpoint's QoS and
+/// the DDS names.
+void run_info(const CommonOptions& o, bool verbose) {
+  runtime::dds::Participant participant(o.domain, environment_partition());
+  const TopicInfo info = find_topic(participant, o);
+  std::printf("Type: %s\nPublisher count: %zu\nSubscription count: %zu\n",
+              runtime::to_ros_type_name(info.type_name).c_str(), info.publishers.size(),
+              info.subscribers.size());
+  if (!verbose) return;
+  std::printf("DDS topic: %s\nDDS type: %s\n", dds_topic_of(o.topic).c_str(),
+              info.type_name.c_str());
+  for (const auto* side : {&info.publishers, &info.subscribers}) {
+    std::printf("%s:\n", side == &info.publishers ? "Publishers" : "Subscriptions");
+    for (const auto& e : *side) std::printf("  QoS: %s\n", e.qos.c_str());
+  }
 }
 
 void run_echo(const CommonOptions& o, const introspection::YamlOptions& yaml) {
@@ -323,6 +363,31 @@ void add_topic_command(Command& app) {
     stop_on_interrupt();
     run_list(list_o, verbose);
   });
+
+  static CommonOptions info_o;
+  static bool info_verbose = false;
+  info_o.wait_s = 1.5;
+  auto* info = topic->add_subcommand(
+      "info", "Type and publisher / subscription counts of a topic (-v: each one's QoS)");
+  add_common(info, info_o, true);
+  info->add_flag("-v,--verbose", info_verbose, "each endpoint's QoS, the DDS names");
+  info->callback([] {
+    stop_on_interrupt();
+    run_info(info_o, info_verbose);
+  });
+
+  static CommonOptions type_o;
+  type_o.wait_s = 1.5;
+  auto* type = topic->add_subcommand("type", "The message type of a topic (ROS name)");
+  add_common(type, type_o, true);
+  type->callback([] {
+    stop_on_interrupt();
+    runtime::dds::Participant participant(type_o.domain, environment_partition());
+    std::printf("%s\n",
+                runtime::to_ros_type_name(find_topic(participant, type_o).type_name).c_str());
+  });
+
+  add_topic_pub_command(topic);
 
   static CommonOptions echo_o;
   static introspection::YamlOptions yaml;

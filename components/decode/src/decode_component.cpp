@@ -113,13 +113,18 @@ class DecodeComponent final : public runtime::Component {
         runtime::ConfigParams<DecoderConfig>()
             .integer("threshold_psi", AVS_FIELD(threshold_psi), 0, 255, "",
                      "Eq. 2: |I_pos - I_neg| must exceed psi (8-bit units)")
+            .live()
             .boolean("code_correction", AVS_FIELD(code_correction),
                      "Algorithm 1 (section 4.4); ignored in full_cycle mode")
+            .live()
             .integer("max_bit_age_pairs", AVS_FIELD(max_bit_age_pairs), 0, 1000, "",
                      "use a bit while at most this many pairs old; 0: n (rolling only; 2n rides "
                      "a static scene through a drop)")
+            .live()
             .real("min_depth_m", AVS_FIELD(min_depth_m), 0.0, 1000.0, "m", "nearer depths are NaN")
+            .live()
             .real("max_depth_m", AVS_FIELD(max_depth_m), 0.0, 1000.0, "m", "farther depths are NaN")
+            .live()
             .choice("triangulation", AVS_FIELD(triangulation),
                     std::vector<std::pair<std::string, TriangulationMethod>>{
                         {"table", TriangulationMethod::kRayPlaneTable},
@@ -147,7 +152,7 @@ class DecodeComponent final : public runtime::Component {
         full_cycle_(ctx.param<std::string>("mode") == "full_cycle"),
         publish_points_(ctx.param<bool>("publish_points")),
         frame_id_(ctx.param<std::string>("frame_id")),
-        decoder_(make_config(ctx)),
+        decoder_(make_config(ctx.parameters(), make_geometry(ctx))),
         rejected_(ctx.log(), "/camera/pattern frame") {
     const SensorGeometry& g = decoder_.config().geometry;
     width_ = g.camera.width;
@@ -188,6 +193,13 @@ class DecodeComponent final : public runtime::Component {
             rejected_.diagnostic()};
   }
 
+  /// The live parameters (threshold, correction, bit age, depth window) take effect from the
+  /// next pair on; the bits kept so far stay.
+  void on_parameters_changed(const runtime::ParameterValues& values,
+                             const std::vector<std::string>& /*changed*/) override {
+    decoder_.retune(make_config(values, decoder_.config().geometry));
+  }
+
   /// Decoder statistics (for tests; same numbers as diagnostic_values()).
   DecoderStats stats() const {
     std::lock_guard lock(mutex_);
@@ -195,13 +207,14 @@ class DecodeComponent final : public runtime::Component {
   }
 
  private:
-  static DecoderConfig make_config(ComponentContext& ctx) {
-    DecoderConfig c = params().make(ctx.parameters());
-    c.geometry = make_geometry(ctx);
+  static DecoderConfig make_config(const runtime::ParameterValues& values,
+                                   SensorGeometry geometry) {
+    DecoderConfig c = params().make(values);
+    c.geometry = std::move(geometry);
     if (!(c.min_depth_m < c.max_depth_m)) {
       throw std::invalid_argument("decode: min_depth_m must be below max_depth_m");
     }
-    if (ctx.param<std::string>("mode") == "full_cycle") {
+    if (values.get<std::string>("mode") == "full_cycle") {
       // Section 4.1: one cycle's bits only (a bit older than the cycle invalidates the map,
       // see RollingDecoder::fresh_mask), no correction.
       c.code_correction = false;

@@ -99,6 +99,29 @@ std::uint32_t update_gray_with_correction(std::uint32_t gray, int k, int new_bit
   return gray;
 }
 
+namespace {
+
+/// The tunable fields of `c` checked; max_bit_age_pairs 0 replaced by `bit_count`.
+DecoderConfig checked_tuning(DecoderConfig c, int bit_count) {
+  if (c.threshold_psi < 0 || c.threshold_psi > 255) {
+    throw std::invalid_argument("rolling decoder: threshold_psi " +
+                                std::to_string(c.threshold_psi) + " outside 0..255");
+  }
+  if (c.max_bit_age_pairs == 0) c.max_bit_age_pairs = bit_count;
+  if (c.max_bit_age_pairs < bit_count) {
+    throw std::invalid_argument("rolling decoder: max_bit_age_pairs " +
+                                std::to_string(c.max_bit_age_pairs) +
+                                " is smaller than the bit count " + std::to_string(bit_count));
+  }
+  if (!(c.min_depth_m < c.max_depth_m)) {
+    throw std::invalid_argument("rolling decoder: min_depth_m " + std::to_string(c.min_depth_m) +
+                                " must be below max_depth_m " + std::to_string(c.max_depth_m));
+  }
+  return c;
+}
+
+}  // namespace
+
 RollingDecoder::RollingDecoder(DecoderConfig config)
     : config_(std::move(config)),
       table_(config_.geometry, config_.subcode_half_window > 0 ? config_.subcode_steps : 0),
@@ -106,16 +129,7 @@ RollingDecoder::RollingDecoder(DecoderConfig config)
       width_(config_.geometry.camera.width),
       height_(config_.geometry.camera.height),
       bit_count_(config_.geometry.layout.bit_count) {
-  if (config_.threshold_psi < 0 || config_.threshold_psi > 255) {
-    throw std::invalid_argument("rolling decoder: threshold_psi " +
-                                std::to_string(config_.threshold_psi) + " outside 0..255");
-  }
-  if (config_.max_bit_age_pairs == 0) config_.max_bit_age_pairs = bit_count_;
-  if (config_.max_bit_age_pairs < bit_count_) {
-    throw std::invalid_argument("rolling decoder: max_bit_age_pairs " +
-                                std::to_string(config_.max_bit_age_pairs) +
-                                " is smaller than the bit count " + std::to_string(bit_count_));
-  }
+  config_ = checked_tuning(std::move(config_), bit_count_);
   const auto pixels = static_cast<std::size_t>(width_) * height_;
   gray_.assign(pixels, 0);
   valid_.assign(pixels, 0);
@@ -134,6 +148,16 @@ RollingDecoder::RollingDecoder(DecoderConfig config)
 RollingDecoder::~RollingDecoder() = default;
 RollingDecoder::RollingDecoder(RollingDecoder&&) noexcept = default;
 RollingDecoder& RollingDecoder::operator=(RollingDecoder&&) noexcept = default;
+
+void RollingDecoder::retune(const DecoderConfig& config) {
+  DecoderConfig c = config_;
+  c.threshold_psi = config.threshold_psi;
+  c.code_correction = config.code_correction;
+  c.min_depth_m = config.min_depth_m;
+  c.max_depth_m = config.max_depth_m;
+  c.max_bit_age_pairs = config.max_bit_age_pairs;
+  config_ = checked_tuning(std::move(c), bit_count_);
+}
 
 void RollingDecoder::reset() {
   std::fill(gray_.begin(), gray_.end(), 0);

@@ -41,7 +41,8 @@ class TrackingComponent final : public runtime::Component {
             "/target, /head/torque_command",
         .parameters = params().specs_with(
             {ParamSpec::boolean("enabled", true,
-                                "false: never track, hold the head's pose (the no-tracking run)"),
+                                "false: never track, hold the head's pose (the no-tracking run)")
+                 .live(),
              ParamSpec::string("joint_names", "pan,tilt",
                                "names of q1 and q2 in /head/joint_states and the command"),
              ParamSpec::string("report_dir", "",
@@ -70,9 +71,12 @@ class TrackingComponent final : public runtime::Component {
     static const auto p =
         runtime::ConfigParams<CoreConfig>()
             .real("depth_min_m", AVS_FIELD(moments.depth_min_m), 0.0, 100.0, "m", "phi_l of Eq. 8")
+            .live()
             .real("depth_max_m", AVS_FIELD(moments.depth_max_m), 0.0, 100.0, "m", "phi_h of Eq. 8")
+            .live()
             .real("min_area_px", AVS_FIELD(moments.min_area_px), 1.0, 1e7, "px",
                   "m00 below this: no target")
+            .live()
             .choice("jacobian", AVS_FIELD(tracker.law.jacobian),
                     std::vector<std::pair<std::string, JacobianForm>>{
                         {"full", JacobianForm::full}, {"simplified", JacobianForm::simplified}},
@@ -81,27 +85,37 @@ class TrackingComponent final : public runtime::Component {
                   "Figure 3: tilt axis to camera centre along X_c (full Jacobian)")
             .vector("kp_nm_per_rad", AVS_FIELD(tracker.law.kp_nm_per_rad), "N m/rad",
                     "K_p (pan, tilt); tuned on servo_tracking_loop.yaml")
+            .live()
             .vector("kv_nm_s_per_rad", AVS_FIELD(tracker.law.kv_nm_s_per_rad), "N m s/rad",
                     "K_v (pan, tilt); tuned on servo_tracking_loop.yaml")
+            .live()
             .vector("m_d_px", AVS_FIELD(tracker.law.m_d_px), "px",
                     "desired image position relative to the principal point")
+            .live()
             .vector("max_torque_nm", AVS_FIELD(tracker.law.max_torque_nm), "N m",
                     "motor torque limit per axis (Table 3)")
+            .live()
             .real("min_cos_q2", AVS_FIELD(tracker.law.min_cos_q2), 0.001, 1.0, "",
                   "|cos q2| floor that keeps J invertible")
             .integer("frames_to_track", AVS_FIELD(tracker.frames_to_track), 1, 100000, "",
                      "consecutive frames with a target before tracking")
+            .live()
             .integer("frames_to_idle", AVS_FIELD(tracker.frames_to_idle), 0, 10000000, "",
                      "frames without target in 'lost' before 'idle'")
+            .live()
             .choice("idle", AVS_FIELD(tracker.idle),
                     std::vector<std::pair<std::string, IdleBehaviour>>{
                         {"hold", IdleBehaviour::hold}, {"return_home", IdleBehaviour::return_home}},
                     "idle behaviour")
+            .live()
             .vector("home_q_rad", AVS_FIELD(tracker.home_q_rad), "rad", "home pose (return_home)")
+            .live()
             .vector("hold_kp_nm_per_rad", AVS_FIELD(tracker.hold_kp_nm_per_rad), "N m/rad",
                     "joint PD for hold / home")
+            .live()
             .vector("hold_kv_nm_s_per_rad", AVS_FIELD(tracker.hold_kv_nm_s_per_rad), "N m s/rad",
-                    "joint PD for hold / home");
+                    "joint PD for hold / home")
+            .live();
     return p;
   }
 
@@ -134,6 +148,19 @@ class TrackingComponent final : public runtime::Component {
 
   std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
     return {rejected_.diagnostic()};
+  }
+
+  /// The live gains, limits, depth window, state thresholds and `enabled` take effect from the
+  /// next depth image on; the tracking state stays.
+  void on_parameters_changed(const runtime::ParameterValues& values,
+                             const std::vector<std::string>& /*changed*/) override {
+    const CoreConfig core = params().make(values);
+    if (!(core.moments.depth_min_m < core.moments.depth_max_m)) {
+      throw std::invalid_argument("depth_min_m must be below depth_max_m");
+    }
+    tracker_.retune(core.tracker);
+    moments_ = core.moments;
+    enabled_ = values.get<bool>("enabled");
   }
 
   void on_deactivate() override {

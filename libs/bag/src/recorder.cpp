@@ -121,9 +121,11 @@ struct Recorder::Impl {
     waitset->wake();
   }
 
-  bool selected(const std::string& ros_topic) const {
+  bool selected(const std::string& dds_topic, const std::string& ros_topic) const {
     if (exclude && std::regex_search(ros_topic, *exclude)) return false;
-    if (options.all) return true;
+    // -a records ROS topics (rt/...), as `ros2 bag record -a`: not the services' rq/ and rr/
+    // samples (the parameter services), nor ros_discovery_info.
+    if (options.all) return dds_topic.rfind("rt/", 0) == 0;
     if (wanted.count(ros_topic) != 0) return true;
     return include && std::regex_search(ros_topic, *include);
   }
@@ -137,7 +139,7 @@ struct Recorder::Impl {
       if (t.writers.insert(p.key).second) t.offered.push_back(p.qos);
       return;
     }
-    if (!selected(ros_topic)) return;
+    if (!selected(p.topic, ros_topic)) return;
     auto t = std::make_unique<RecordedTopic>();
     t->dds_topic = p.topic;
     t->ros_topic = ros_topic;

@@ -1,6 +1,5 @@
 // Reading one component entry: type, name, typed parameters, remaps and QoS overrides,
 // each checked against the component's registered spec.
-#include <charconv>
 
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/error.hpp"
@@ -15,22 +14,6 @@ using runtime::ParamType;
 using runtime::ParamValue;
 
 const std::vector<std::string> component_keys = {"type", "name", "parameters", "remap", "qos"};
-
-std::optional<double> parse_double(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  double v = 0.0;
-  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
-  return v;
-}
-
-std::optional<std::int64_t> parse_int(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  std::int64_t v = 0;
-  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (s.empty() || ec != std::errc() || end != s.data() + s.size()) return std::nullopt;
-  return v;
-}
 
 /// What `spec` expects, as check() words it ("expected a number in [0, 1] m").
 std::string expectation(const ParamSpec& spec) {
@@ -74,13 +57,13 @@ std::optional<ParamValue> read_list(const FileReader& reader, const ParamSpec& s
     }
     auto text = node.IsSequence() ? reader.string(list[i], what) : list[i].Scalar();
     if (!text) return std::nullopt;
-    auto v = parse_double(*text);
-    if (!v) {
+    const ParamValue v = runtime::parse_param_text(ParamType::real, *text);
+    if (!std::holds_alternative<double>(v)) {
       reader.error(item, what + ": " + expectation(spec) + ", got '" + *text + "' at index " +
                              std::to_string(i));
       return std::nullopt;
     }
-    values.push_back(*v);
+    values.push_back(std::get<double>(v));
   }
   return ParamValue{std::move(values)};
 }
@@ -99,26 +82,7 @@ std::optional<ParamValue> read_param(const FileReader& reader, const ParamSpec& 
     }
     auto text = reader.string(node, what);
     if (!text) return std::nullopt;
-    value = ParamValue{*text};  // a string makes check() report the expected type
-    switch (spec.type) {
-      case ParamType::boolean:  // only true/false: "yes", "on", "1" are typos more often than not
-        if (*text == "true") value = ParamValue{true};
-        if (*text == "false") value = ParamValue{false};
-        break;
-      case ParamType::integer:
-        if (auto i = parse_int(*text)) value = ParamValue{*i};
-        break;
-      case ParamType::real:
-        if (auto i = parse_int(*text)) {
-          value = ParamValue{static_cast<double>(*i)};
-        } else if (auto d = parse_double(*text)) {
-          value = ParamValue{*d};
-        }
-        break;
-      case ParamType::string:
-      case ParamType::real_list:
-        break;
-    }
+    value = runtime::parse_param_text(spec.type, *text);
   }
   if (const std::string problem = spec.check(*value); !problem.empty()) {
     reader.error(node, what + ": " + problem);

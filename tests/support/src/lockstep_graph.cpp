@@ -11,8 +11,9 @@ namespace avs::testing {
 
 namespace {
 
-ContainerRun run_container(const std::vector<std::string>& components, const std::string& clock,
-                           int domain) {
+/// The graph of run_lockstep_container (or in wall time) loaded and its container made, not run.
+ContainerRun load_container(const std::vector<std::string>& components, double duration_s,
+                            TestClock clock, int domain) {
   if (domain < 0) domain = test_domain();
   const auto file = std::filesystem::temp_directory_path() /
                     ("avs_lockstep_" + std::to_string(getpid()) + "_" + std::to_string(domain) +
@@ -20,7 +21,9 @@ ContainerRun run_container(const std::vector<std::string>& components, const std
   {
     std::ofstream out(file);
     out << "domain_id: " << domain << "\n"
-        << "clock: " << clock << "\n"
+        << (clock == TestClock::lockstep ? "clock: {source: sim, mode: lockstep, duration_s: "
+                                         : "clock: {source: wall, duration_s: ")
+        << duration_s << "}\n"
         << "containers:\n"
         << "  - name: test\n"
         << "    executor: single_threaded\n"
@@ -34,7 +37,6 @@ ContainerRun run_container(const std::vector<std::string>& components, const std
   if (!loaded.ok()) return run;
   run.graph = std::make_unique<graph::Graph>(std::move(*loaded.graph));
   run.container = std::make_unique<runtime::Container>(*run.graph, run.graph->containers.front());
-  run.status = run.container->run();
   return run;
 }
 
@@ -42,15 +44,34 @@ ContainerRun run_container(const std::vector<std::string>& components, const std
 
 ContainerRun run_lockstep_container(const std::vector<std::string>& components, double duration_s,
                                     int domain) {
-  return run_container(
-      components, "{source: sim, mode: lockstep, duration_s: " + std::to_string(duration_s) + "}",
-      domain);
+  ContainerRun run = load_container(components, duration_s, TestClock::lockstep, domain);
+  if (run.container) run.status = run.container->run();
+  return run;
 }
 
 ContainerRun run_wall_clock_container(const std::vector<std::string>& components, double duration_s,
                                       int domain) {
-  return run_container(components, "{source: wall, duration_s: " + std::to_string(duration_s) + "}",
-                       domain);
+  ContainerRun run = load_container(components, duration_s, TestClock::wall, domain);
+  if (run.container) run.status = run.container->run();
+  return run;
+}
+
+BackgroundContainer::BackgroundContainer(const std::vector<std::string>& components,
+                                         double duration_s, TestClock clock, int domain)
+    : run_(load_container(components, duration_s, clock, domain)) {
+  if (run_.container) thread_ = std::thread([this] { run_.status = run_.container->run(); });
+}
+
+BackgroundContainer::~BackgroundContainer() {
+  stop();
+}
+
+int BackgroundContainer::stop() {
+  if (thread_.joinable()) {
+    run_.container->stop();
+    thread_.join();
+  }
+  return run_.status;
 }
 
 }  // namespace avs::testing

@@ -154,6 +154,17 @@ class Component {
     return {};
   }
 
+  /// Dynamic parameters (ParamSpec::dynamic) changed while the graph runs (`avs param set`,
+  /// ROS 2 set_parameters). Called on the component's thread between two of its callbacks,
+  /// never during one: `values` holds every parameter with the new ones, `changed` names
+  /// those that changed. Apply them (e.g. re-make the core's Config), or throw to refuse the
+  /// whole change (the message goes back to the caller, nothing is applied). The container
+  /// has checked names, types, ranges and the dynamic flag; context().parameters() shows the
+  /// new values once this returns. The default refuses loudly: a component that declares a
+  /// dynamic parameter must override it.
+  virtual void on_parameters_changed(const ParameterValues& values,
+                                     const std::vector<std::string>& changed);
+
  protected:
   ComponentContext& context() { return context_; }
   const Logger& log() const { return context_.log(); }

@@ -11,7 +11,9 @@
 //   }
 #pragma once
 
+#include <charconv>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <optional>
 #include <string>
@@ -36,7 +38,7 @@ class ConfigParams {
                       std::optional<double> max, std::string unit, std::string description) && {
     const Config d{};
     add(
-        ParamSpec::real(name, static_cast<double>(get(d)), min, max, std::move(unit),
+        ParamSpec::real(name, as_decimal(get(d)), min, max, std::move(unit),
                         std::move(description)),
         [get, name](const ParameterValues& v, Config& c) {
           using T = std::remove_cvref_t<decltype(get(c))>;
@@ -143,7 +145,28 @@ class ConfigParams {
     return std::move(*this);
   }
 
+  /// Marks the parameter added last as dynamic (ParamSpec::dynamic): changeable while the
+  /// graph runs; the component re-makes its Config (make()) in on_parameters_changed.
+  ConfigParams&& live() && {
+    if (specs_.empty()) throw Error("ConfigParams::live() before any parameter");
+    specs_.back().dynamic = true;
+    return std::move(*this);
+  }
+
   const std::vector<ParamSpec>& specs() const { return specs_; }
+
+  /// A float field's default as the decimal it was written as (0.05f -> 0.05, not
+  /// 0.05000000074505806); it converts back to the same float.
+  template <class T>
+  static double as_decimal(T value) {
+    if constexpr (std::is_same_v<T, float>) {
+      char text[32];
+      const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+      return std::strtod(std::string(text, end).c_str(), nullptr);
+    } else {
+      return static_cast<double>(value);
+    }
+  }
 
   /// specs() followed by `more` (the component's own parameters, not the core's).
   std::vector<ParamSpec> specs_with(std::vector<ParamSpec> more) const {

@@ -47,7 +47,10 @@ class Entity {
 /// option), never from the environment: the command line reads AVS_DOMAIN_ID/AVS_PARTITION.
 class Participant : public Entity {
  public:
-  explicit Participant(dds_domainid_t domain = 0, std::string partition = {});
+  /// `user_data`: the participant's USER_DATA QoS, e.g. "enclave=/;" which ROS 2 (rmw_dds_common)
+  /// needs to take the participant's nodes into its graph; empty: none.
+  explicit Participant(dds_domainid_t domain = 0, std::string partition = {},
+                       const std::string& user_data = {});
   const std::string& partition() const { return partition_; }
   /// Puts the partition into the QoS of a reader or writer of this participant (every
   /// endpoint of a user topic goes through this; built-in topic readers see all partitions).

@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <variant>
 #include <vector>
 
@@ -21,7 +22,8 @@ std::string to_string(ParamType type);
 std::string to_string(const ParamValue& value);
 ParamType type_of(const ParamValue& value);
 
-/// Shortest text that reads back as the same double ("0.1", "10000", "1e-06").
+/// Shortest text that reads back as the same double ("0.1", "1e-06"); whole numbers as
+/// integers ("10000", "10000000").
 std::string format_number(double v);
 /// " in [0.1, 10000]", " >= 0", " <= 5" or "" (no bounds): the one way ranges are shown.
 std::string range_text(std::optional<double> min, std::optional<double> max);
@@ -36,6 +38,10 @@ struct ParamSpec {
   std::vector<std::string> choices;  ///< allowed values for strings, empty = any
   std::string unit;                  ///< "Hz", "m", "rad", "" for none
   std::string description;
+  /// Changeable while the graph runs (`avs param set`, ROS 2 set_parameters): the component
+  /// applies a change between two callbacks (Component::on_parameters_changed). False: read
+  /// when the component starts (sizes, ports, files); a change needs a restart.
+  bool dynamic = false;
 
   static ParamSpec boolean(std::string name, bool def, std::string description);
   static ParamSpec integer(std::string name, std::int64_t def, std::optional<double> min,
@@ -47,10 +53,23 @@ struct ParamSpec {
   static ParamSpec real_list(std::string name, std::vector<double> def, std::string unit,
                              std::string description);
 
+  /// This spec, marked dynamic: `ParamSpec::real(...).live()`.
+  ParamSpec live() &&;
+
   /// Empty when `value` is acceptable; otherwise what was expected, e.g.
   /// "expected a number in [0.1, 10000] Hz, got 0".
   std::string check(const ParamValue& value) const;
 };
+
+/// The value `text` means for a parameter of `type`, as a YAML scalar or flow list says it
+/// ("30", "0.5", "true", "[1, 2.5]", "rolling"): the one reading of parameter text, shared by
+/// the graph loader and `avs param set`. Text that is not of the type comes back as a string
+/// value, so that ParamSpec::check() says what was expected.
+ParamValue parse_param_text(ParamType type, std::string_view text);
+
+/// The value as YAML writes it: numbers and booleans plain, strings quoted when YAML would
+/// read them otherwise (`avs param dump`), lists in flow style.
+std::string to_yaml_text(const ParamValue& value);
 
 /// Values of all declared parameters of one component instance, defaults filled in.
 class ParameterValues {

@@ -25,6 +25,14 @@ std::shared_ptr<T> make_sample() {
   });
 }
 
+/// A zeroed sample of any type given by its descriptor and size (e.g. for dds_take of a type
+/// known at run time), freed with everything it gets.
+inline std::shared_ptr<void> make_sample(const dds_topic_descriptor_t* descriptor,
+                                         std::size_t size) {
+  return std::shared_ptr<void>(
+      dds_alloc(size), [descriptor](void* p) { dds_sample_free(p, descriptor, DDS_FREE_ALL); });
+}
+
 /// Replaces a C string field with a copy of `value`.
 inline void set_string(char*& field, std::string_view value) {
   dds_free(field);

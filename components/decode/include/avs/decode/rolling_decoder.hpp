@@ -123,6 +123,13 @@ class RollingDecoder {
   /// Forget all bits and statistics.
   void reset();
 
+  /// Takes the fields of `config` that may change between two frames (threshold_psi,
+  /// code_correction, min_depth_m, max_depth_m, max_bit_age_pairs; 0 = bit_count); the
+  /// others (geometry, triangulation, sub-code refinement, point map) stay as constructed.
+  /// The bits kept so far stay; the next pair uses the new values. Throws
+  /// std::invalid_argument, changing nothing, when a value is out of range.
+  void retune(const DecoderConfig& config);
+
   /// Binary code per pixel of the current window (after correction), -1 where invalid.
   std::vector<int> code_map() const;
   const DecoderConfig& config() const { return config_; }

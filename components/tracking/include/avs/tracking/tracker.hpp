@@ -56,6 +56,13 @@ class Tracker {
     config_.law.fy_px = fy_px;
   }
   void reset() { *this = Tracker(config_); }
+  /// New gains, limits and state thresholds from the next update on (a parameter changed while
+  /// running); the tracking state and the focal lengths in force stay.
+  void retune(TrackerConfig config) {
+    config.law.fx_px = config_.law.fx_px;
+    config.law.fy_px = config_.law.fy_px;
+    config_ = std::move(config);
+  }
 
  private:
   Eigen::Vector2d joint_pd(const Eigen::Vector2d& q_goal, const JointState& joints) const;

@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "avs/graph/graph.hpp"
@@ -36,5 +37,29 @@ ContainerRun run_lockstep_container(const std::vector<std::string>& components, 
 /// on their own threads, e.g. camera + sim_camera). Never assert speed with it.
 ContainerRun run_wall_clock_container(const std::vector<std::string>& components, double duration_s,
                                       int domain = -1);
+
+enum class TestClock { lockstep, wall };
+
+/// The same container run on a thread of its own, so that the test acts on it while it runs
+/// (another process changing a parameter, say). stop() (or the destructor) ends it; read the
+/// components' state only after stop(). Lockstep runs as fast as the machine does: a graph
+/// with little work to do reaches `duration_s` at once; TestClock::wall runs it in wall time.
+class BackgroundContainer {
+ public:
+  BackgroundContainer(const std::vector<std::string>& components, double duration_s,
+                      TestClock clock = TestClock::lockstep, int domain = -1);
+  ~BackgroundContainer();
+  BackgroundContainer(const BackgroundContainer&) = delete;
+  BackgroundContainer& operator=(const BackgroundContainer&) = delete;
+
+  /// The graph and container (container null when the graph did not load: see load_errors).
+  const ContainerRun& run() const { return run_; }
+  /// Stops the container and waits for it; its run() status.
+  int stop();
+
+ private:
+  ContainerRun run_;
+  std::thread thread_;
+};
 
 }  // namespace avs::testing
