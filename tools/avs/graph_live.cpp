@@ -35,7 +35,7 @@ std::string guid_text(const dds_guid_t& g, int bytes = 12) {
 }
 
 /// The QoS policies that decide matching, read from a discovered endpoint.
-struct EndpointQos {
+struct MatchQos {
   bool reliable = false;
   bool transient_local = false;
   dds_duration_t deadline = DDS_INFINITY;
@@ -47,8 +47,8 @@ struct EndpointQos {
   std::string text;
 };
 
-EndpointQos read_qos(const dds_qos_t* q) {
-  EndpointQos e;
+MatchQos read_qos(const dds_qos_t* q) {
+  MatchQos e;
   dds_reliability_kind_t rel;
   dds_duration_t blocking;
   if (q != nullptr && dds_qget_reliability(q, &rel, &blocking))
@@ -90,7 +90,7 @@ EndpointQos read_qos(const dds_qos_t* q) {
 struct Endpoint {
   std::string participant;  ///< GUID prefix text
   std::string topic, type;
-  EndpointQos qos;
+  MatchQos qos;
 };
 
 std::string partitions_text(const std::vector<std::string>& p) {

@@ -34,14 +34,14 @@ std::string full_name(const runtime::NodeEntities& n) {
   return (n.node_namespace == "/" ? "" : n.node_namespace) + "/" + n.node_name;
 }
 
-struct EndpointInfo {
+struct NodeEndpoint {
   std::string topic;  ///< DDS name
   std::string type;   ///< DDS type name
 };
 
 /// Every remote reader and writer DDS discovery shows (built-in topics), by GUID.
-std::map<runtime::Gid, EndpointInfo> endpoints(const runtime::dds::Participant& participant) {
-  std::map<runtime::Gid, EndpointInfo> out;
+std::map<runtime::Gid, NodeEndpoint> endpoints(const runtime::dds::Participant& participant) {
+  std::map<runtime::Gid, NodeEndpoint> out;
   for (const auto builtin :
        {DDS_BUILTIN_TOPIC_DCPSPUBLICATION, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION}) {
     runtime::dds::Entity reader(runtime::check_dds(
@@ -86,7 +86,7 @@ void run_list(const NodeOptions& o) {
 
 /// "/depth/image: sensor_msgs/msg/Image", or for a service request reader
 /// "/decode/get_parameters: rcl_interfaces/srv/GetParameters".
-std::string describe(const EndpointInfo& e, bool verbose) {
+std::string describe(const NodeEndpoint& e, bool verbose) {
   std::string name = e.topic;
   std::string type = runtime::to_ros_type_name(e.type);
   if (name.rfind("rt/", 0) == 0) name = runtime::from_dds_topic_name(name);
