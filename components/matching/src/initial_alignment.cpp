@@ -17,6 +17,25 @@ FeatureConfig with_radius(FeatureConfig config, float spacing_m) {
   return config;
 }
 
+/// The shortest rotation taking `from` onto `to` (any lengths): the arithmetic of Eigen's
+/// Quaternion::FromTwoVectors away from the antiparallel case. Eigen's antiparallel branch
+/// instantiates a JacobiSVD that took a third of this file's compile time; here the half turn
+/// is about any axis orthogonal to `from`, which serves the plane hypotheses (they scan the
+/// in-plane angle anyway).
+Eigen::Matrix3f rotation_onto(const Eigen::Vector3f& from, const Eigen::Vector3f& to) {
+  const Eigen::Vector3f v0 = from.normalized();
+  const Eigen::Vector3f v1 = to.normalized();
+  const float c = v1.dot(v0);
+  if (c < -1.0F + Eigen::NumTraits<float>::dummy_precision()) {
+    return Eigen::AngleAxisf(std::numbers::pi_v<float>, v0.unitOrthogonal()).toRotationMatrix();
+  }
+  const float s = std::sqrt((1.0F + c) * 2.0F);
+  Eigen::Quaternionf q;
+  q.vec() = v0.cross(v1) * (1.0F / s);
+  q.w() = s * 0.5F;
+  return q.toRotationMatrix();
+}
+
 IcpConfig refine_config(const InitialAlignmentConfig& config) {
   IcpConfig icp;
   icp.iterations = config.refine_iterations;
@@ -257,8 +276,7 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
                      static_cast<float>(std::max<std::size_t>(1, config_.plane_rotations));
   for (const auto& scene : scene_planes) {
     for (const auto& face : model_faces_) {
-      const Eigen::Matrix3f onto =
-          Eigen::Quaternionf::FromTwoVectors(face.normal, scene.normal).toRotationMatrix();
+      const Eigen::Matrix3f onto = rotation_onto(face.normal, scene.normal);
       for (std::size_t r = 0; r < config_.plane_rotations; ++r) {
         Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
         T_camera_model.linear() =
