@@ -276,16 +276,16 @@ inline std::vector<std::byte> nine_chunk_bag(std::vector<ChunkIndex>& chunks,
   for (std::uint64_t chunk_size = 1800; chunk_size > 1000; chunk_size -= 20) {
     WriterOptions options = golden_options(Compression::zstd);
     options.chunk_size_bytes = chunk_size;
-    EXPECT_TRUE(write_test_bag(path, options, golden_messages()).ok());
+    chunks.clear();
+    if (!write_test_bag(path, options, golden_messages()).ok()) break;
     bytes = read_bytes(path);
     Reader reader;
-    EXPECT_TRUE(reader.open_memory(bytes).ok());
-    EXPECT_TRUE(reader.read_summary().ok());
+    if (!reader.open_memory(bytes).ok() || !reader.read_summary().ok()) break;
     chunks = reader.summary().chunk_indexes;
     if (chunks.size() >= 9) break;
   }
   std::filesystem::remove(path);
-  EXPECT_EQ(chunks.size(), 9u) << "no chunk size gives 9 chunks";
+  if (chunks.size() != 9) return {};  // the caller checks for 9 chunks
   if (corrupt < chunks.size()) {
     const ChunkIndex& c = chunks[corrupt];
     bytes[c.chunk_start_offset + c.chunk_length - c.compressed_size / 2] ^= std::byte{0x08};

@@ -749,10 +749,12 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
     if (Status s = read_record(index.chunk_start_offset,
                                index.chunk_start_offset + index.chunk_length, slot.raw, record);
         !s.ok()) {
+      free_slots.push_back(slot_id);
       return Status(StatusCode::malformed, where + ": " + s.message());
     }
     if (record.opcode != static_cast<std::uint8_t>(Opcode::chunk) ||
         record.total_length() != index.chunk_length) {
+      free_slots.push_back(slot_id);
       return Status(StatusCode::malformed, where + " does not point at a Chunk record of length " +
                                                std::to_string(index.chunk_length) + " (found " +
                                                opcode_name(record.opcode) + ")");
