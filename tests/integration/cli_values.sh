@@ -20,6 +20,15 @@ refused "--rate: a finite number is needed, got inf" bag play none.mcap --rate i
 refused "--domain: Value 300 not in range" topic list --domain 300
 refused "--width: Value 100000 not in range" patterns --width 100000 --out /nonexistent
 refused "--seconds: a finite number is needed, got inf" demo --seconds inf
+refused "--max-gap: Value 0 not in range" bag play none.mcap --max-gap 0
+# The benchmarks' own options (bench::Options): the benchmark, option and range, never "stod".
+if "$avs" bench 2>/dev/null | grep -q '^servo'; then
+  refused "avs bench servo: --rate wants a number in [1, 100000], got 'abc'" bench servo --rate abc
+  refused "avs bench sim: --frames wants an integer in [10, 1000000], got '2.5'" bench sim --frames=2.5
+  refused "avs bench matching: --poses wants an integer in [1, 100000], got 'nan'" bench matching --poses nan
+  refused "avs bench bag: --duration wants a number in [0.1, 3600], got '-1'" bench bag --duration=-1
+  refused "avs bench servo: unknown option --sconds" bench servo --sconds=3
+fi
 
 "$avs" topic echo /no_such_topic --wait 60 >/dev/null 2>&1 &
 pid=$!

@@ -176,5 +176,27 @@ TEST(InitialAlignmentLrfs, TooSmallSceneIsInvalid) {
   EXPECT_FALSE(aligner.align(Points{{0.0F, 0.0F, 0.5F}, {0.01F, 0.0F, 0.5F}}).valid);
 }
 
+TEST(InitialAlignmentScale, ExtremeModelScalesEndInBoundedWorkOrAClearError) {
+  // Issue 20 section 2: the ken's mesh scaled by 1e12-1e30 made the aligner's DistanceGrid spin
+  // in the constructor (at load, ignoring SIGTERM). Every scale now either builds (bounded
+  // grid) or is refused with a message naming the size; none may hang (the CTest timeout).
+  const ObjectPreset ken = builtin_objects()[0];
+  for (const float scale : {1e-9F, 1e4F, 1e12F, 1e20F, 1e30F}) {
+    SCOPED_TRACE("scale " + std::to_string(scale));
+    geometry::Mesh mesh = ken.mesh;
+    for (auto& v : mesh.vertices) v *= scale;
+    ModelCloudConfig config;
+    config.target_points = ken.model_points;
+    try {
+      const ModelCloud model = make_model_cloud(mesh, config);
+      const InitialAligner aligner(model);
+      EXPECT_LT(scale, 1e6F) << "a model of this size should be refused";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_GE(scale, 1e6F) << e.what();  // ken is 0.2 m: 1e4 is 2 km, accepted
+      EXPECT_NE(std::string(e.what()).find(" m across"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace avs::matching

@@ -347,5 +347,45 @@ TEST(MatchingComponent, UnknownModelFailsTheContainerLoudly) {
   EXPECT_NE(container.run(), 0);
 }
 
+/// An ASCII PLY cube of `side_m`, outward faces, in a temporary file.
+std::filesystem::path write_cube_ply(double side_m, const std::string& name) {
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("avs_matching_" + name + "_" + std::to_string(getpid()) + ".ply");
+  std::ofstream out(file);
+  out << "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n"
+         "property float z\nelement face 6\nproperty list uchar int vertex_indices\n"
+         "end_header\n";
+  for (int i = 0; i < 8; ++i) {
+    out << (i & 1) * side_m << " " << ((i >> 1) & 1) * side_m << " " << ((i >> 2) & 1) * side_m
+        << "\n";
+  }
+  out << "4 0 2 3 1\n4 4 5 7 6\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n";
+  return file;
+}
+
+TEST(MatchingComponent, ImplausibleModelSizesAreSaidAndAnUnusableOneFailsTheLoad) {
+  // Issue 20 section 2: meshes at 1e-9 m or 10 km were accepted silently (0 % success later);
+  // one scaled by 1e12 hung the load. The first two load with a warning naming the size, the
+  // third fails the container's start-up with the size in the error.
+  for (const auto& [side_m, loads] :
+       {std::pair{1e-9, true}, std::pair{1e4, true}, std::pair{1e12, false}}) {
+    SCOPED_TRACE("cube of " + std::to_string(side_m) + " m");
+    const auto file = write_cube_ply(side_m, "cube");
+    ::testing::internal::CaptureStderr();
+    const avs::testing::ContainerRun ran = avs::testing::run_lockstep_container(
+        {"{type: matching, name: matching, parameters: {model: " + file.string() + "}}"}, 0.01);
+    const std::string err = ::testing::internal::GetCapturedStderr();
+    std::filesystem::remove(file);
+    for (const auto& e : ran.load_errors) ADD_FAILURE() << e;
+    if (loads) {
+      EXPECT_EQ(ran.status, 0) << err;
+      EXPECT_NE(err.find("m across: implausible"), std::string::npos) << err;
+    } else {
+      EXPECT_NE(ran.status, 0) << err;
+      EXPECT_NE(err.find("m across, above the"), std::string::npos) << err;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace avs::matching

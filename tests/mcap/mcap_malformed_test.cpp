@@ -276,6 +276,126 @@ TEST(McapMalformed, HostileFieldsAreRejectedWithOffsets) {
   EXPECT_TRUE(names_an_offset(s)) << s.to_string();
 }
 
+TEST(McapMalformed, RepairInPlaceKeepsEveryIntactChunkAndNeverWritesOverItsInputWithLess) {
+  // Issue 20 section 2: `avs bag repair` in place turned a bag with a valid summary, 8 of its 9
+  // chunks intact and one flipped bit into 168 bytes without a message, exit 0.
+  std::vector<ChunkIndex> chunks;
+  const auto bytes = nine_chunk_bag(chunks, 4);
+  ASSERT_EQ(chunks.size(), 9u);
+  const ChunkIndex victim = chunks[4];
+  const auto input = temp_path("flipped.mcap");
+  write_bytes(input, bytes);
+
+  RepairReport report;
+  const Status in_place = repair_file(input, input, report);
+
+  // The input is untouched; the result beside it holds every message of the 8 intact chunks.
+  EXPECT_EQ(in_place.code(), StatusCode::incomplete) << in_place.to_string();
+  EXPECT_NE(in_place.message().find("did not replace"), std::string::npos) << in_place.to_string();
+  EXPECT_TRUE(read_bytes(input) == bytes) << "repair wrote over its input";
+  ASSERT_EQ(report.skipped_chunks.size(), 1u);
+  EXPECT_EQ(report.skipped_chunks[0].offset, victim.chunk_start_offset);
+  EXPECT_EQ(report.chunks_kept, 8u);
+  EXPECT_TRUE(report.input_had_summary);
+  EXPECT_EQ(report.input_summary_messages, golden_messages().size());
+  const std::size_t intact = messages_outside(victim);
+  EXPECT_EQ(report.messages_kept, intact);
+  EXPECT_EQ(report.written_to.string(), input.string() + ".repaired.mcap");
+  Reader repaired;
+  ASSERT_TRUE(repaired.open(report.written_to).ok());
+  ASSERT_TRUE(repaired.read_summary().ok());
+  std::vector<ReadMessage> got;
+  ASSERT_TRUE(read_all(repaired, got).ok());
+  EXPECT_EQ(got.size(), intact);
+
+  // To another file the same result is the asked-for outcome.
+  const auto output = temp_path("flipped_out.mcap");
+  RepairReport elsewhere;
+  const Status to_output = repair_file(input, output, elsewhere);
+  EXPECT_TRUE(to_output.ok()) << to_output.to_string();
+  EXPECT_EQ(elsewhere.messages_kept, intact);
+  EXPECT_EQ(elsewhere.skipped_chunks.size(), 1u);
+  for (const auto& p : {input, output, report.written_to}) std::filesystem::remove(p);
+}
+
+TEST(McapMalformed, ASkippingReaderGoesOnPastACorruptChunk) {
+  std::vector<ChunkIndex> chunks;
+  const auto bytes = nine_chunk_bag(chunks, 2);
+  ASSERT_EQ(chunks.size(), 9u);
+  const ChunkIndex victim = chunks[2];
+  ReaderOptions skipping;
+  skipping.skip_corrupt_chunks = true;
+  for (const bool with_summary : {true, false}) {
+    SCOPED_TRACE(with_summary ? "through the summary" : "by a linear scan");
+    auto input = bytes;
+    if (!with_summary) input.resize(chunks.back().chunk_start_offset + chunks.back().chunk_length);
+    Reader reader;
+    ASSERT_TRUE(reader.open_memory(input, skipping).ok());
+    std::vector<ReadMessage> got;
+    ReadReport report;
+    ReadOptions options;
+    options.allow_truncated = true;
+    const Status s = read_all(reader, got, options, &report);
+    ASSERT_TRUE(s.ok()) << s.to_string();
+    EXPECT_EQ(report.used_summary, with_summary);
+    ASSERT_EQ(report.skipped_chunks.size(), 1u);
+    EXPECT_EQ(report.skipped_chunks[0].offset, victim.chunk_start_offset);
+    EXPECT_NE(report.skipped_chunks[0].problem.find("offset"), std::string::npos);
+    EXPECT_EQ(got.size(), messages_outside(victim));
+  }
+  // A strict reader still fails on it.
+  std::vector<ReadMessage> got;
+  EXPECT_FALSE(read_memory(bytes, got).ok());
+}
+
+TEST(McapMalformed, AZstdBombHitsTheDecompressedSizeLimit) {
+  // Issue 20 section 2: 8 chunks claiming 128 MiB each (101 KB of zstd) took 2.4 GB. One chunk
+  // of 80 MiB of zeros, a few KB compressed: refused by its claimed size before any allocation,
+  // and, with a claim of 1 MiB, by the real size when decompressing.
+  const auto path = temp_path("bomb.mcap");
+  {
+    WriterOptions options;
+    options.compression = Compression::zstd;
+    options.chunk_size_bytes = 96u << 20;
+    Writer writer;
+    ASSERT_TRUE(writer.open(path, options).ok());
+    SchemaId schema = 0;
+    ChannelId channel = 0;
+    ASSERT_TRUE(writer.add_schema("std_msgs/msg/String", "ros2msg", kStringSchema, schema).ok());
+    ASSERT_TRUE(
+        writer.add_channel("/bomb", "cdr", schema, {{"offered_qos_profiles", kQos}}, channel).ok());
+    const std::vector<std::byte> zeros(1u << 20);
+    for (std::uint32_t i = 0; i < 80; ++i) {
+      ASSERT_TRUE(writer.write(channel, 1000 + i, 1000 + i, zeros, i).ok());
+    }
+    ASSERT_TRUE(writer.close().ok());
+  }
+  auto bytes = read_bytes(path);
+  std::filesystem::remove(path);
+  EXPECT_LT(bytes.size(), 1u << 20) << "not a bomb";
+  Reader reader;
+  ASSERT_TRUE(reader.open_memory(bytes).ok());
+  ASSERT_TRUE(reader.read_summary().ok());
+  ASSERT_EQ(reader.summary().chunk_indexes.size(), 1u);
+  const ChunkIndex chunk = reader.summary().chunk_indexes[0];
+  std::vector<ReadMessage> got;
+  Status s = read_all(reader, got);
+  EXPECT_EQ(s.code(), StatusCode::too_large) << s.to_string();
+  EXPECT_NE(s.message().find("above the reader limit " +
+                             std::to_string(ReaderOptions{}.max_chunk_uncompressed_bytes)),
+            std::string::npos)
+      << s.to_string();
+  EXPECT_TRUE(got.empty());
+
+  auto understated = bytes;  // the chunk claims 1 MiB: decompression stops there
+  detail::write_u64_at(understated.data() + chunk.chunk_start_offset + 9 + 16, 1u << 20);
+  s = read_memory(understated, got);
+  EXPECT_EQ(s.code(), StatusCode::malformed) << s.to_string();
+  EXPECT_NE(s.message().find("offset " + std::to_string(chunk.chunk_start_offset)),
+            std::string::npos)
+      << s.to_string();
+}
+
 /// Seeded random mutations of the golden files: each read must end in an error or success,
 /// never a crash (the libFuzzer target, run under AddressSanitizer, digs deeper).
 TEST(McapFuzz, TwentyThousandSeededMutationsNeverCrash) {

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "avs/mcap/reader.hpp"
 #include "avs/mcap/writer.hpp"
 
@@ -262,6 +264,42 @@ inline Status read_all(Reader& reader, std::vector<ReadMessage>& out,
         return true;
       },
       options, report);
+}
+
+/// The golden content in exactly 9 zstd chunks, with its summary (the bag had 9), and
+/// one bit flipped in the compressed records of chunk `corrupt` (none when out of range).
+inline std::vector<std::byte> nine_chunk_bag(std::vector<ChunkIndex>& chunks,
+                                             std::size_t corrupt = 9) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("avs_mcap_nine_chunks_" + std::to_string(::getpid()) + ".mcap");
+  std::vector<std::byte> bytes;
+  for (std::uint64_t chunk_size = 1800; chunk_size > 1000; chunk_size -= 20) {
+    WriterOptions options = golden_options(Compression::zstd);
+    options.chunk_size_bytes = chunk_size;
+    chunks.clear();
+    if (!write_test_bag(path, options, golden_messages()).ok()) break;
+    bytes = read_bytes(path);
+    Reader reader;
+    if (!reader.open_memory(bytes).ok() || !reader.read_summary().ok()) break;
+    chunks = reader.summary().chunk_indexes;
+    if (chunks.size() >= 9) break;
+  }
+  std::filesystem::remove(path);
+  if (chunks.size() != 9) return {};  // the caller checks for 9 chunks
+  if (corrupt < chunks.size()) {
+    const ChunkIndex& c = chunks[corrupt];
+    bytes[c.chunk_start_offset + c.chunk_length - c.compressed_size / 2] ^= std::byte{0x08};
+  }
+  return bytes;
+}
+
+/// Messages of the golden content outside `chunk`'s time range (its chunks do not overlap).
+inline std::size_t messages_outside(const ChunkIndex& chunk) {
+  std::size_t n = 0;
+  for (const auto& m : golden_messages()) {
+    n += m.log_time < chunk.message_start_time || m.log_time > chunk.message_end_time ? 1 : 0;
+  }
+  return n;
 }
 
 }  // namespace avs::mcap::test

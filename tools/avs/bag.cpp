@@ -181,7 +181,15 @@ int run_play(PlayArgs& a) {
     for (const auto& [topic, n] : r.per_topic) {
       std::printf("  %-32s %llu\n", topic.c_str(), static_cast<unsigned long long>(n));
     }
-    if (!r.skipped.empty()) status = 3;
+    if (!r.skipped_chunks.empty()) {
+      std::printf("skipped %zu corrupt chunk(s) (`avs bag repair -o` keeps the rest)\n",
+                  r.skipped_chunks.size());
+    }
+    if (r.gaps_shortened > 0) {
+      std::printf("shortened %llu gap(s) above --max-gap %g s\n",
+                  static_cast<unsigned long long>(r.gaps_shortened), a.options.max_gap_s);
+    }
+    if (!r.skipped.empty() || !r.skipped_chunks.empty()) status = 3;
   } catch (const std::exception& e) {
     if (tty) std::fprintf(stderr, "\r\033[K");
     std::cerr << e.what() << "\n";
@@ -207,19 +215,28 @@ int run_info(const std::string& file) {
 int run_repair(const std::string& file, std::string output) {
   if (output.empty()) output = file;
   mcap::RepairReport report;
-  if (mcap::Status s = mcap::repair_file(file, output, report); !s.ok()) {
+  const mcap::Status s = mcap::repair_file(file, output, report);
+  if (!s.ok() && report.written_to.empty()) {
     std::cerr << "avs bag repair: " << file << ": " << s.to_string() << "\n";
     return 1;
   }
-  std::cout << "repaired " << file << " -> " << output << ": kept " << report.chunks_kept
-            << " chunks, " << report.messages_kept << " messages";
+  std::cout << "repaired " << file << " -> " << report.written_to.string() << ": kept "
+            << report.chunks_kept << " chunks, " << report.messages_kept << " messages";
   if (report.bytes_dropped > 0)
     std::cout << "; dropped the last " << report.bytes_dropped << " bytes";
   std::cout << "\n";
+  for (const auto& chunk : report.skipped_chunks) {
+    std::cout << "  left out the corrupt chunk at offset " << chunk.offset << ": " << chunk.problem
+              << "\n";
+  }
   if (!report.stopped_because.empty())
     std::cout << "  scan stopped: " << report.stopped_because << "\n";
-  if (report.input_had_summary) std::cout << "  (the input already had a valid summary)\n";
-  return 0;
+  if (report.input_had_summary) {
+    std::cout << "  (the input had a valid summary counting " << report.input_summary_messages
+              << " messages)\n";
+  }
+  if (!s.ok()) std::cerr << "avs bag repair: " << s.to_string() << "\n";
+  return s.ok() && report.skipped_chunks.empty() ? 0 : 3;
 }
 
 void add_bag_command(Command& app) {
@@ -293,6 +310,11 @@ void add_bag_command(Command& app) {
                    "wait S seconds after creating the writers (discovery)")
       ->capture_default_str()
       ->check_range(0, 3600);
+  play->add_option("--max-gap", pl.options.max_gap_s,
+                   "wait at most S seconds of bag time between two messages (a longer gap, "
+                   "e.g. a corrupt log_time, is shortened and said)")
+      ->capture_default_str()
+      ->check_range(1e-3, 1e6);
   pl.options.partition = environment_partition();
   add_domain_option(play, pl.options.domain);
   play->callback([] { exit_status() = run_play(pl); });
@@ -307,7 +329,12 @@ void add_bag_command(Command& app) {
   auto* repair = bag->add_subcommand(
       "repair", "Rewrite the index and summary of a file cut short (e.g. a killed recorder)");
   repair->add_option("file", repair_file, "MCAP file")->required();
-  repair->add_option("-o,--output", repair_output, "write here instead of replacing FILE");
+  repair->add_option("-o,--output", repair_output,
+                     "write here instead of replacing FILE (FILE is replaced only when nothing "
+                     "is lost; otherwise the result goes to FILE.repaired.mcap)");
+  repair->footer(
+      "Exit status: 0 repaired; 3 repaired with corrupt parts left out (FILE kept as it was when "
+      "repairing in place); 1 error.");
   repair->callback([] { exit_status() = run_repair(repair_file, repair_output); });
 }
 

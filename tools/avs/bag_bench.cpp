@@ -50,50 +50,34 @@ struct BenchArgs {
 /// separately, so `--key value` may arrive out of order) or `--key value`.
 BenchArgs parse_args(const std::vector<std::string>& raw) {
   BenchArgs a;
-  const std::vector<std::string> args = bench::option_words(raw);
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size())
-        throw runtime::Error("avs bench bag: " + args[i] + " needs a value");
-      return args[++i];
-    };
-    const std::string& k = args[i];
-    if (k == "--duration") {
-      a.duration_s = std::stod(value());
-    } else if (k == "--fps") {
-      a.fps = std::stod(value());
-    } else if (k == "--size") {
-      a.width = a.height = std::stoi(value());
-    } else if (k == "--role") {
-      a.role = value();
-    } else if (k == "--dir") {
-      a.dir = value();
-    } else if (k == "--publisher-history") {
-      a.history = std::stoi(value());
-    } else if (k == "--keep") {
-      a.keep = true;
-    } else if (k == "--domain") {
-      a.domain = std::stoi(value());
-    } else if (k == "--compression") {
-      a.compressions.clear();
-      std::stringstream ss(value());
-      for (std::string c; std::getline(ss, c, ',');) a.compressions.push_back(c);
-    } else if (k == "--help" || k == "-h") {
-      std::printf(
-          "avs bench bag [--duration=S] [--fps=N] [--size=PX] [--compression=none,lz4,zstd]\n"
-          "              [--dir=DIR] [--keep] [--domain=ID] [--publisher-history=N]\n"
-          "Records /bench_bag/pattern_frames (avs_msgs/PatternFrame, PXxPX mono8, N fps) with\n"
-          "/bench_bag/target (1 kHz), /bench_bag/torque (1 kHz) and /bench_bag/match (100 Hz) from "
-          "a\n"
-          "publisher process for S seconds per compression; files go to DIR (default $TMPDIR or "
-          "/tmp)\n"
-          "and are deleted unless --keep. The publisher is reliable KEEP_ALL, or KEEP_LAST N with\n"
-          "--publisher-history=N (to show the losses a reader is not told about).\n");
-      std::exit(0);
-    } else {
-      throw runtime::Error("avs bench bag: unknown argument " + k + " (see --help)");
-    }
+  bench::Options given("bag", raw, {"--keep", "--help", "-h"});
+  if (given.flag("--help") || given.flag("-h")) {
+    std::printf(
+        "avs bench bag [--duration=S] [--fps=N] [--size=PX] [--compression=none,lz4,zstd]\n"
+        "              [--dir=DIR] [--keep] [--domain=ID] [--publisher-history=N]\n"
+        "Records /bench_bag/pattern_frames (avs_msgs/PatternFrame, PXxPX mono8, N fps) with\n"
+        "/bench_bag/target (1 kHz), /bench_bag/torque (1 kHz) and /bench_bag/match (100 Hz) from "
+        "a\n"
+        "publisher process for S seconds per compression; files go to DIR (default $TMPDIR or "
+        "/tmp)\n"
+        "and are deleted unless --keep. The publisher is reliable KEEP_ALL, or KEEP_LAST N with\n"
+        "--publisher-history=N (to show the losses a reader is not told about).\n");
+    std::exit(0);
   }
+  a.duration_s = given.number("--duration", a.duration_s, 0.1, 3600.0);
+  a.fps = given.number("--fps", a.fps, 1.0, 10000.0);
+  a.width = a.height = static_cast<int>(given.integer("--size", a.width, 8, 4096));
+  a.role = given.text("--role", a.role);
+  a.dir = given.text("--dir", a.dir);
+  a.history = static_cast<int>(given.integer("--publisher-history", a.history, 0, 1000000));
+  a.keep = given.flag("--keep");
+  a.domain = static_cast<int>(given.integer("--domain", a.domain, -1, 232));
+  if (const std::string list = given.text("--compression", ""); !list.empty()) {
+    a.compressions.clear();
+    std::stringstream ss(list);
+    for (std::string c; std::getline(ss, c, ',');) a.compressions.push_back(c);
+  }
+  given.finish();
   if (a.domain < 0) a.domain = domain_or_environment(0);
   return a;
 }

@@ -248,19 +248,11 @@ RunResult run_pair(PeerOptions o, const std::string& xml) {
 bench::Report transport_bench(const std::vector<std::string>& args) {
   PeerOptions o;
   o.count = 5000;
-  // "--count=N" or "--count N" (avs bench passes unknown options on in any order).
-  const std::vector<std::string> words = bench::option_words(args);
-  for (std::size_t i = 0; i < words.size(); i += 2) {
-    const std::string& key = words[i];
-    if (i + 1 >= words.size() || (key != "--count" && key != "--rate" && key != "--bytes")) {
-      throw std::runtime_error("avs bench transport: unexpected '" + key +
-                               "' (options: --count=N, --rate=HZ, --bytes=B)");
-    }
-    const std::string& value = words[i + 1];
-    if (key == "--count") o.count = std::stoi(value);
-    if (key == "--rate") o.rate_hz = std::stod(value);
-    if (key == "--bytes") o.bytes = std::stoi(value);
-  }
+  bench::Options given("transport", args);
+  o.count = static_cast<int>(given.integer("--count", o.count, 1, 10000000));
+  o.rate_hz = given.number("--rate", o.rate_hz, 1.0, 100000.0);
+  o.bytes = static_cast<int>(given.integer("--bytes", o.bytes, 16, 64 << 20));
+  given.finish();
   o.domain = domain_or_environment(179);
   // One local host, on lo, as a deployment would configure it.
   deploy::Deployment d;

@@ -164,47 +164,38 @@ struct Options {
 
 Options parse_options(const std::vector<std::string>& raw) {
   Options o;
-  const std::vector<std::string> words = bench::option_words(raw);
-  for (std::size_t i = 0; i < words.size(); ++i) {
-    const std::string& k = words[i];
-    if (k == "--help" || k == "-h") {
-      std::printf(
-          "avs bench pipeline [--json] [--seconds=S] [--placements=intra_process,udp,shm]\n"
-          "                   [--recorded-frames=N] [--dir=DIR]\n"
-          "Replays N rendered /camera/pattern frames (the ken on the manipulator trajectory,\n"
-          "forwards and backwards by cycle) at 1000 fps of wall-clock time for S seconds per\n"
-          "placement into decode -> tracking -> matching; writes latency figures and CSV to DIR\n"
-          "(default ./avs_bench_pipeline).\n");
-      std::exit(0);
+  bench::Options given("pipeline", raw, {"--help", "-h"});
+  if (given.flag("--help") || given.flag("-h")) {
+    std::printf(
+        "avs bench pipeline [--json] [--seconds=S] [--placements=intra_process,udp,shm]\n"
+        "                   [--recorded-frames=N] [--dir=DIR]\n"
+        "Replays N rendered /camera/pattern frames (the ken on the manipulator trajectory,\n"
+        "forwards and backwards by cycle) at 1000 fps of wall-clock time for S seconds per\n"
+        "placement into decode -> tracking -> matching; writes latency figures and CSV to DIR\n"
+        "(default ./avs_bench_pipeline).\n");
+    std::exit(0);
+  }
+  o.seconds = given.number("--seconds", o.seconds, 0.1, 3600.0);
+  o.recorded_frames =
+      static_cast<int>(given.integer("--recorded-frames", o.recorded_frames, 1, 100000));
+  o.dir = given.text("--dir", o.dir.string());
+  if (const std::string v = given.text("--placements", ""); !v.empty()) {
+    o.placements.clear();
+    std::stringstream ss(v);
+    std::vector<std::string> asked;
+    for (std::string p; std::getline(ss, p, ',');) {
+      if (p != "intra_process" && p != "udp" && p != "shm") {
+        throw runtime::Error("avs bench pipeline: unknown placement '" + p +
+                             "' (intra_process, udp, shm)");
+      }
+      asked.push_back(p);
     }
-    if (i + 1 >= words.size()) throw runtime::Error("avs bench pipeline: " + k + " needs a value");
-    const std::string& v = words[++i];
-    if (k == "--seconds") {
-      o.seconds = std::stod(v);
-    } else if (k == "--recorded-frames") {
-      o.recorded_frames = std::stoi(v);
-    } else if (k == "--dir") {
-      o.dir = v;
-    } else if (k == "--placements") {
-      o.placements.clear();
-      std::stringstream ss(v);
-      std::vector<std::string> asked;
-      for (std::string p; std::getline(ss, p, ',');) {
-        if (p != "intra_process" && p != "udp" && p != "shm") {
-          throw runtime::Error("avs bench pipeline: unknown placement '" + p +
-                               "' (intra_process, udp, shm)");
-        }
-        asked.push_back(p);
-      }
-      // Always in this order: shm must be the last (see pipeline_bench).
-      for (const char* p : {"intra_process", "udp", "shm"}) {
-        if (std::find(asked.begin(), asked.end(), p) != asked.end()) o.placements.push_back(p);
-      }
-    } else {
-      throw runtime::Error("avs bench pipeline: unknown argument " + k + " (see --help)");
+    // Always in this order: shm must be the last (see pipeline_bench).
+    for (const char* p : {"intra_process", "udp", "shm"}) {
+      if (std::find(asked.begin(), asked.end(), p) != asked.end()) o.placements.push_back(p);
     }
   }
-  if (!(o.seconds > 0)) throw runtime::Error("avs bench pipeline: --seconds must be positive");
+  given.finish();
   return o;
 }
 

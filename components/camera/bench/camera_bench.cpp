@@ -35,14 +35,12 @@ std::int64_t realtime_ns() {
 }
 
 bench::Report run(const std::vector<std::string>& args) {
-  double seconds = 30, rate_hz = 1000;
-  int packet_size = 0, socket_buffer = 0;
-  for (std::size_t i = 0; i + 1 < args.size(); ++i) {
-    if (args[i] == "--seconds") seconds = std::max(1.0, std::stod(args[i + 1]));
-    if (args[i] == "--rate") rate_hz = std::max(1.0, std::stod(args[i + 1]));
-    if (args[i] == "--packet-size") packet_size = std::stoi(args[i + 1]);
-    if (args[i] == "--socket-buffer") socket_buffer = std::stoi(args[i + 1]);
-  }
+  bench::Options options("camera", args);
+  const double seconds = options.number("--seconds", 30.0, 1.0, 3600.0);
+  const double rate_hz = options.number("--rate", 1000.0, 1.0, 100000.0);
+  const int packet_size = static_cast<int>(options.integer("--packet-size", 0, 0, 65507));
+  const int socket_buffer = static_cast<int>(options.integer("--socket-buffer", 0, 0, 1 << 30));
+  options.finish();
   // One cycle of the simulator's frames of a plane 1 m ahead.
   sim::SimulatorConfig sim_config;
   sim_config.frame_rate_hz = rate_hz;

@@ -47,29 +47,17 @@ struct Options {
 };
 
 Options parse(const std::vector<std::string>& args) {
+  ::avs::bench::Options given("matching", args);
   Options options;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    auto value = [&]() -> const std::string& {
-      if (i + 1 >= args.size())
-        throw std::invalid_argument("avs bench matching: " + args[i] + " needs a value");
-      return args[++i];
-    };
-    if (args[i] == "--model") {
-      options.model_path = value();
-    } else if (args[i] == "--symmetry") {
-      options.symmetry = parse_symmetry(value());
-    } else if (args[i] == "--model-points") {
-      options.model_points = std::stoul(value());
-    } else if (args[i] == "--scene-points") {
-      options.scene_points = std::stoul(value());
-    } else if (args[i] == "--poses") {
-      options.poses = std::stoi(value());
-    } else {
-      throw std::invalid_argument(
-          "avs bench matching: unknown argument '" + args[i] +
-          "' (expected --model, --symmetry, --model-points, --scene-points, --poses)");
-    }
-  }
+  options.model_path = given.text("--model", "");
+  const std::string symmetry = given.text("--symmetry", "");
+  if (!symmetry.empty()) options.symmetry = parse_symmetry(symmetry);
+  options.model_points = static_cast<std::size_t>(
+      given.integer("--model-points", static_cast<long long>(options.model_points), 3, 100000));
+  options.scene_points = static_cast<std::size_t>(
+      given.integer("--scene-points", static_cast<long long>(options.scene_points), 3, 100000));
+  options.poses = static_cast<int>(given.integer("--poses", options.poses, 1, 100000));
+  given.finish();
   return options;
 }
 

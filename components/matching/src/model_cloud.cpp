@@ -66,6 +66,20 @@ ModelCloud make_model_cloud(const geometry::Mesh& mesh, const ModelCloudConfig& 
                                 std::to_string(config.target_points) + ") <= surface_samples (" +
                                 std::to_string(config.surface_samples) + ")");
   }
+  // 0. A size the float clouds, voxel keys and distance grid can work with. Far beyond it (a
+  //    mesh scaled by 1e12-1e30) areas overflow and voxel keys saturate, and the failure named
+  //    a symptom ("no surface area", "needs 3 points"); say the size instead (issue 20).
+  Eigen::AlignedBox3d box_m;
+  for (const auto& v : mesh.vertices) {
+    if (!v.allFinite()) throw std::invalid_argument("make_model_cloud: a vertex is not finite");
+    box_m.extend(v.cast<double>());
+  }
+  const double size_m = box_m.isEmpty() ? 0.0 : box_m.diagonal().norm();
+  if (size_m > kMaxModelSizeM) {
+    throw std::invalid_argument("make_model_cloud: the mesh is " + std::to_string(size_m) +
+                                " m across, above the " + std::to_string(kMaxModelSizeM) +
+                                " m a model may be (is it in metres?)");
+  }
   // 1. Dense uniform samples.
   const SurfaceSamples samples = sample_surface(mesh, config.surface_samples, config.seed);
 
@@ -74,8 +88,10 @@ ModelCloud make_model_cloud(const geometry::Mesh& mesh, const ModelCloudConfig& 
   //    result is then searched over a few sizes and grid offsets for the closest count.
   Eigen::AlignedBox3f box;
   for (const auto& p : samples.points_m) box.extend(p);
-  double small = 1e-5;
-  double large = std::max(1e-4, static_cast<double>(box.diagonal().maxCoeff()));
+  // The bracket scales with the model, so a tiny one (a mesh in the wrong unit, warned about by
+  // the matching component) still gets voxels smaller than itself.
+  double small = std::min(1e-5, 1e-4 * size_m);
+  double large = std::max(10.0 * small, static_cast<double>(box.diagonal().maxCoeff()));
   VoxelGridScratch scratch;
   Points shifted;
   Points points;

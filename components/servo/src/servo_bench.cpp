@@ -109,12 +109,10 @@ LoopFigures run_peer(int port, double rate_hz, double seconds) {
 }
 
 bench::Report run_bench(const std::vector<std::string>& args) {
-  double seconds = 3.0;
-  double rate_hz = 1000.0;
-  for (std::size_t i = 0; i + 1 < args.size(); ++i) {
-    if (args[i] == "--seconds") seconds = std::stod(args[i + 1]);
-    if (args[i] == "--rate") rate_hz = std::stod(args[i + 1]);
-  }
+  bench::Options options("servo", args);
+  const double seconds = options.number("--seconds", 3.0, 0.1, 3600.0);
+  const double rate_hz = options.number("--rate", 1000.0, 1.0, 100000.0);
+  options.finish();
   AmplifierServerConfig server_config;
   server_config.clock = ClockMode::own_thread;
   server_config.step_period_s = 1.0 / rate_hz;

@@ -104,10 +104,9 @@ double brute_force_ms_per_frame(const Simulator& sim, double t_s, const HeadStat
 }
 
 bench::Report run(const std::vector<std::string>& args) {
-  int frames = 300;
-  for (std::size_t i = 0; i + 1 < args.size(); ++i) {
-    if (args[i] == "--frames") frames = std::max(10, std::stoi(args[i + 1]));
-  }
+  bench::Options options("sim", args);
+  const int frames = static_cast<int>(options.integer("--frames", 300, 10, 1000000));
+  options.finish();
   SimulatorConfig config;
   Simulator moving(config, bench_scene(true));
   Simulator still(config, bench_scene(false));

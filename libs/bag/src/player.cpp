@@ -49,13 +49,19 @@ class Pacer {
     wall_start_ = SteadyClock::now();
     paused_total_ = {};
     last_clock_ = 0;
+    gap_skipped_ns_ = 0;
+    previous_ = bag_start_;
   }
+
+  /// Gaps above max_gap_s shortened so far.
+  std::uint64_t gaps_shortened() const { return gaps_shortened_; }
 
   bool stopped() const { return control_.stop != nullptr && control_.stop->load(); }
 
   /// Waits until `t` is due (publishing /clock and progress meanwhile); false when stopped.
   bool wait_until(mcap::Timestamp t, std::uint64_t published) {
     published_ = published;
+    shorten_gap(t);
     for (;;) {
       if (stopped()) return false;
       const bool paused = control_.paused != nullptr && control_.paused->load();
@@ -80,6 +86,24 @@ class Pacer {
         std::this_thread::yield();
       }
     }
+  }
+
+  /// A gap from the previous message above max_gap_s is cut to max_gap_s: the pacing skips
+  /// the rest (told on stderr, the first few times).
+  void shorten_gap(mcap::Timestamp t) {
+    const auto max_gap_ns = static_cast<mcap::Timestamp>(options_.max_gap_s * 1e9);
+    if (t > previous_ && t - previous_ > max_gap_ns) {
+      const mcap::Timestamp cut = t - previous_ - max_gap_ns;
+      if (++gaps_shortened_ <= 5) {
+        std::fprintf(stderr,
+                     "avs bag play: %.3f s without a message before log time %llu ns (a corrupt "
+                     "log_time?): waiting %.3f s instead (--max-gap)%s\n",
+                     static_cast<double>(t - previous_) * 1e-9, static_cast<unsigned long long>(t),
+                     options_.max_gap_s, gaps_shortened_ == 5 ? "; not saying this again" : "");
+      }
+      gap_skipped_ns_ += cut;
+    }
+    previous_ = std::max(previous_, t);
   }
 
   void publish_clock(mcap::Timestamp t) {
@@ -116,7 +140,8 @@ class Pacer {
  private:
   mcap::Timestamp bag_time_at(SteadyClock::time_point now) const {
     const double elapsed = std::chrono::duration<double>(now - wall_start_ - paused_total_).count();
-    return bag_start_ + static_cast<mcap::Timestamp>(std::max(0.0, elapsed) * options_.rate * 1e9);
+    return bag_start_ + gap_skipped_ns_ +
+           static_cast<mcap::Timestamp>(std::max(0.0, elapsed) * options_.rate * 1e9);
   }
 
   const PlayOptions& options_;
@@ -130,14 +155,33 @@ class Pacer {
   mcap::Timestamp last_clock_ = 0;
   std::uint64_t published_ = 0;
   int pass_ = 0;
+  mcap::Timestamp previous_ = 0;        // the last message's log time (bag_start at first)
+  mcap::Timestamp gap_skipped_ns_ = 0;  // bag time cut out of long gaps this pass
+  std::uint64_t gaps_shortened_ = 0;
 };
+
+/// Says, and keeps in `result`, each corrupt chunk the reader left out.
+void report_skipped_chunks(const std::filesystem::path& file,
+                           const std::vector<mcap::SkippedChunk>& chunks, PlayResult& result) {
+  for (const auto& chunk : chunks) {
+    std::fprintf(stderr, "avs bag play: %s: skipped the corrupt chunk at offset %llu: %s\n",
+                 file.string().c_str(), static_cast<unsigned long long>(chunk.offset),
+                 chunk.problem.c_str());
+    result.skipped_chunks.push_back("offset " + std::to_string(chunk.offset) + ": " +
+                                    chunk.problem);
+  }
+}
 
 }  // namespace
 
 PlayResult play(const PlayOptions& o, const PlayControl& control) {
   if (!(o.rate > 0)) throw Error("avs bag play: --rate must be > 0");
+  if (!(o.max_gap_s > 0)) throw Error("avs bag play: --max-gap must be > 0");
   mcap::Reader reader;
-  if (mcap::Status s = reader.open(o.file); !s.ok()) {
+  mcap::ReaderOptions reader_options;
+  reader_options.skip_corrupt_chunks = true;  // one bad chunk does not end the replay
+  PlayResult result;
+  if (mcap::Status s = reader.open(o.file, reader_options); !s.ok()) {
     throw Error("avs bag play: " + o.file.string() + ": " + s.to_string());
   }
   bool truncated = false;
@@ -147,6 +191,7 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
       throw Error("avs bag play: " + o.file.string() + ": " + s2.to_string());
     }
     truncated = scan.truncated;
+    report_skipped_chunks(o.file, scan.skipped_chunks, result);
     std::fprintf(
         stderr,
         "avs bag play: %s has no usable summary (%s); playing what a scan finds%s "
@@ -178,7 +223,6 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
   for (const auto& [from, to] : o.remaps) remaps[ros_name(from)] = ros_name(to);
 
   dds::Participant participant(o.domain, o.partition);
-  PlayResult result;
   std::map<std::string, std::unique_ptr<dds::RawWriter>> writers;  // by published ROS name
   std::map<mcap::ChannelId, ChannelPlan> plans;
   std::set<std::string> read_topics;
@@ -242,6 +286,7 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
   for (int pass = 0;; ++pass) {
     pacer.begin_pass(pass);
     std::string write_error;
+    mcap::ReadReport read_report;
     const mcap::Status s = reader.read_messages(
         [&](const mcap::MessageView& m) {
           auto plan = plans.find(m.channel->id);
@@ -258,7 +303,12 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
           ++result.per_topic[plan->second.published_as];
           return true;
         },
-        ro);
+        ro, &read_report);
+    // A scan at open has said its skipped chunks already; the chunk indexes' are said once.
+    if (pass == 0 && read_report.used_summary) {
+      report_skipped_chunks(o.file, read_report.skipped_chunks, result);
+    }
+    result.gaps_shortened = pacer.gaps_shortened();
     if (!write_error.empty()) throw Error("avs bag play: " + write_error);
     if (!s.ok()) throw Error("avs bag play: " + o.file.string() + ": " + s.to_string());
     if (!o.loop || pacer.stopped()) break;

@@ -21,6 +21,8 @@ const char* status_code_name(StatusCode code) {
       return "unsupported";
     case StatusCode::too_large:
       return "too large";
+    case StatusCode::incomplete:
+      return "incomplete";
   }
   return "unknown";
 }

@@ -468,6 +468,7 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
   Statistics stats;
   bool stopped_by_callback = false;
   ChunkIndex* last_chunk = nullptr;  // the chunk whose Message Index records may follow
+  std::vector<std::pair<std::uint64_t, MessageFields>> chunk_messages;  // one chunk's, checked
   std::uint64_t pos = header_end_;
   result.last_complete_offset = pos;
 
@@ -510,11 +511,13 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
     const auto op = static_cast<Opcode>(record.opcode);
     ChunkMessageIndex chunk_index;
     bool keep_last_chunk = false;
+    bool skipped = false;  // a corrupt chunk left out (ReaderOptions::skip_corrupt_chunks)
     if (op == Opcode::data_end) {
       Cursor c(record.content, base, where);
       std::uint32_t stored = c.u32();
       if (!c.ok()) return c.status();
-      if (stored != 0) {
+      // A skipped chunk's bytes are still in the CRC: it cannot match, and says nothing more.
+      if (stored != 0 && result.skipped_chunks.empty()) {
         if (stored != crc) {
           return Status(StatusCode::crc_mismatch, "data section CRC up to the Data End record at " +
                                                       at(pos) + " is " + hex(crc) +
@@ -552,15 +555,30 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
         break;
       }
       case Opcode::chunk: {
+        // The whole chunk is checked before any of its messages is counted or delivered, so
+        // that a chunk skipped as corrupt contributes nothing.
         ChunkView chunk;
-        if (Status s = load_chunk(record, decompressed, chunk); !s.ok()) return s;
-        Status walked = walk_chunk(chunk, [&](std::uint64_t offset, const MessageFields& fields) {
+        chunk_messages.clear();
+        Status loaded = load_chunk(record, decompressed, chunk);
+        if (loaded.ok()) {
+          loaded = walk_chunk(chunk, [&](std::uint64_t offset, const MessageFields& fields) {
+            chunk_messages.emplace_back(offset, fields);
+            return Status{};
+          });
+        }
+        if (!loaded.ok()) {
+          if (!options_.skip_corrupt_chunks || loaded.code() == StatusCode::io_error) {
+            return loaded;
+          }
+          result.skipped_chunks.push_back({pos, loaded.message()});
+          skipped = true;
+          break;
+        }
+        for (const auto& [offset, fields] : chunk_messages) {
           chunk_index[fields.channel_id].emplace_back(fields.log_time, offset);
           count_message(fields);
           deliver(fields);
-          return Status{};
-        });
-        if (!walked.ok()) return walked;
+        }
         ChunkIndex index;
         index.message_start_time = chunk.message_start_time;
         index.message_end_time = chunk.message_end_time;
@@ -611,7 +629,7 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
         break;  // private records are skipped
     }
     if (!keep_last_chunk) last_chunk = nullptr;
-    if (hook) {
+    if (hook && !skipped) {
       if (Status s = hook(record, op == Opcode::chunk ? &chunk_index : nullptr); !s.ok()) {
         return s;
       }
@@ -642,7 +660,8 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
 
 Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
                              bool trust_index_channels, const ReadOptions& options,
-                             const MessageCallback& on_message, std::uint64_t& delivered) {
+                             const MessageCallback& on_message, std::uint64_t& delivered,
+                             std::vector<SkippedChunk>& skipped) {
   std::set<ChannelId> wanted;
   const bool filter_topics = !options.topics.empty();
   for (const auto& [id, channel] : channels_) {
@@ -679,6 +698,7 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
     std::vector<Entry> entries;
     std::size_t next = 0;
     std::size_t order = 0;
+    std::uint64_t held_bytes = 0;  ///< counted against max_loaded_uncompressed_bytes
   };
   std::vector<std::unique_ptr<Slot>> slots;
   std::vector<std::size_t> free_slots;
@@ -694,8 +714,15 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
     }
   };
   std::priority_queue<Head, std::vector<Head>, std::greater<Head>> heads;
+  std::uint64_t loaded_bytes = 0;  // uncompressed bytes of the chunks held by the merge
+  auto release = [&](std::size_t slot_id) {
+    Slot& slot = *slots[slot_id];
+    loaded_bytes -= slot.held_bytes;
+    slot.held_bytes = 0;
+    free_slots.push_back(slot_id);
+  };
 
-  auto load = [&](std::size_t order) -> Status {
+  auto load_one = [&](std::size_t order) -> Status {
     const ChunkIndex& index = *chunks[order];
     const std::string where = "Chunk Index for the chunk at " + at(index.chunk_start_offset);
     if (index.chunk_start_offset < header_end_ || index.chunk_start_offset > data_limit ||
@@ -722,16 +749,23 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
     if (Status s = read_record(index.chunk_start_offset,
                                index.chunk_start_offset + index.chunk_length, slot.raw, record);
         !s.ok()) {
+      free_slots.push_back(slot_id);
       return Status(StatusCode::malformed, where + ": " + s.message());
     }
     if (record.opcode != static_cast<std::uint8_t>(Opcode::chunk) ||
         record.total_length() != index.chunk_length) {
+      free_slots.push_back(slot_id);
       return Status(StatusCode::malformed, where + " does not point at a Chunk record of length " +
                                                std::to_string(index.chunk_length) + " (found " +
                                                opcode_name(record.opcode) + ")");
     }
     ChunkView chunk;
-    if (Status s = load_chunk(record, slot.decompressed, chunk); !s.ok()) return s;
+    if (Status s = load_chunk(record, slot.decompressed, chunk); !s.ok()) {
+      free_slots.push_back(slot_id);
+      return s;
+    }
+    slot.held_bytes = chunk.uncompressed_size;
+    loaded_bytes += slot.held_bytes;
     Status walked = walk_chunk(chunk, [&](std::uint64_t offset, const MessageFields& fields) {
       if (fields.log_time >= options.start_time && fields.log_time <= options.end_time &&
           (!filter_topics || options.topics.count(channels_.at(fields.channel_id).topic) > 0)) {
@@ -739,14 +773,34 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
       }
       return Status{};
     });
-    if (!walked.ok()) return walked;
+    if (!walked.ok()) {
+      release(slot_id);
+      return walked;
+    }
     std::stable_sort(slot.entries.begin(), slot.entries.end(),
                      [](const Entry& a, const Entry& b) { return a.log_time < b.log_time; });
     if (slot.entries.empty()) {
-      free_slots.push_back(slot_id);
+      release(slot_id);
     } else {
       heads.push({slot.entries[0].log_time, order, 0, slot_id});
     }
+    return {};
+  };
+  // A chunk that cannot be read: an error, or (skip_corrupt_chunks) left out and reported. The
+  // memory limit of the merge is never skipped: the chunk may be intact.
+  auto load = [&](std::size_t order) -> Status {
+    const ChunkIndex& index = *chunks[order];
+    if (index.uncompressed_size > options_.max_loaded_uncompressed_bytes - loaded_bytes) {
+      return Status(StatusCode::too_large,
+                    "the chunk at " + at(index.chunk_start_offset) + " (" +
+                        std::to_string(index.uncompressed_size) + " bytes uncompressed) with the " +
+                        std::to_string(loaded_bytes) +
+                        " bytes of the chunks overlapping it in time is above the reader limit " +
+                        std::to_string(options_.max_loaded_uncompressed_bytes));
+    }
+    Status s = load_one(order);
+    if (s.ok() || !options_.skip_corrupt_chunks || s.code() == StatusCode::io_error) return s;
+    skipped.push_back({index.chunk_start_offset, s.message()});
     return {};
   };
 
@@ -767,7 +821,7 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
     if (++slot.next < slot.entries.size()) {
       heads.push({slot.entries[slot.next].log_time, slot.order, slot.next, head.slot});
     } else {
-      free_slots.push_back(head.slot);
+      release(head.slot);
     }
   }
   return {};

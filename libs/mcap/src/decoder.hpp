@@ -64,7 +64,7 @@ class Decoder {
   /// `trust_index_channels`: skip chunks whose message_index_offsets lack wanted channels.
   Status read_indexed(const Summary& summary, std::uint64_t data_limit, bool trust_index_channels,
                       const ReadOptions& options, const MessageCallback& on_message,
-                      std::uint64_t& delivered);
+                      std::uint64_t& delivered, std::vector<SkippedChunk>& skipped);
 
   const std::map<SchemaId, Schema>& schemas() const { return schemas_; }
   const std::map<ChannelId, Channel>& channels() const { return channels_; }

@@ -117,6 +117,7 @@ Status Reader::read_messages(const MessageCallback& on_message, const ReadOption
     out.used_linear_scan = true;
     ScanResult scanned;
     if (Status s = m.decoder->scan(scanned, options.allow_truncated, {}, {}); !s.ok()) return s;
+    out.skipped_chunks = scanned.skipped_chunks;
     out.truncated = scanned.truncated;
     out.truncated_at = scanned.truncated_at;
     out.truncation_detail = scanned.truncation_detail;
@@ -138,7 +139,7 @@ Status Reader::read_messages(const MessageCallback& on_message, const ReadOption
     data_limit = scanned.last_complete_offset;
   }
   return m.decoder->read_indexed(m.summary, data_limit, m.summary_from_file, options, on_message,
-                                 out.messages_delivered);
+                                 out.messages_delivered, out.skipped_chunks);
 }
 
 }  // namespace avs::mcap

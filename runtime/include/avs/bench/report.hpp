@@ -56,6 +56,36 @@ inline std::vector<std::string> option_words(const std::vector<std::string>& arg
   return words;
 }
 
+/// A benchmark's options read with their ranges: numbers must be finite, whole where an integer
+/// is asked for, and in range, or std::invalid_argument says which benchmark, option and range
+/// ("avs bench servo: --rate wants a number in [1, 100000], got 'abc'"), never a bare "stod".
+/// Values come as "--key value" or "--key=value" (option_words()); `flags` take no value;
+/// finish() refuses options no one asked for.
+class Options {
+ public:
+  Options(std::string bench, const std::vector<std::string>& args,
+          const std::vector<std::string>& flags = {});
+
+  /// Whether the flag (one of the constructor's `flags`) was given.
+  bool flag(const std::string& key);
+  double number(const std::string& key, double fallback, double min, double max);
+  long long integer(const std::string& key, long long fallback, long long min, long long max);
+  std::string text(const std::string& key, std::string fallback);
+  /// Throws for an option that none of number(), integer(), text() asked for.
+  void finish() const;
+
+ private:
+  /// The value given for `key` (nullptr: not given); marks it used.
+  const std::string* value(const std::string& key);
+  [[noreturn]] void refuse(const std::string& key, const std::string& wanted,
+                           const std::string& got) const;
+
+  std::string bench_;
+  std::map<std::string, std::string> given_;
+  std::map<std::string, bool> used_;
+  std::vector<std::string> asked_;  ///< every key asked for, in order (for finish()'s message)
+};
+
 inline bool register_bench(std::string name, std::string description, BenchFunction run) {
   bench_registry().push_back({std::move(name), std::move(description), std::move(run)});
   return true;

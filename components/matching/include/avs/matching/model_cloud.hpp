@@ -40,8 +40,14 @@ struct ModelCloud {
 [[nodiscard]] SurfaceSamples sample_surface(const geometry::Mesh& mesh, std::size_t count,
                                             std::uint32_t seed);
 
+/// The largest model, corner to corner, make_model_cloud() accepts: 1000 km, far above any
+/// object a depth camera matches (matching warns from 5 m), well below where float coordinates
+/// at the voxel sizes it searches stop working.
+inline constexpr double kMaxModelSizeM = 1e6;
+
 /// Samples the surface, then searches the voxel size whose down-sampled cloud is closest to
-/// config.target_points.
+/// config.target_points. Throws std::invalid_argument for a non-finite vertex or a mesh above
+/// kMaxModelSizeM across.
 [[nodiscard]] ModelCloud make_model_cloud(const geometry::Mesh& mesh,
                                           const ModelCloudConfig& config);
 

@@ -22,6 +22,9 @@ struct PlayOptions {
   bool clock = false;                         ///< publish rosgraph_msgs/Clock (log time) on /clock
   double clock_period_s = 0.01;  ///< /clock also between messages, at least this often (bag time)
   double delay_s = 0.5;  ///< wait after creating the writers (discovery) before the first sample
+  /// Longest wait between two messages, in bag time: a longer gap (a corrupted log_time once
+  /// made play wait 73 years) is shortened to this and said.
+  double max_gap_s = 10.0;
   int domain = 0;
   std::string partition;  ///< DDS partition of the readers/writers; empty: default
 };
@@ -44,6 +47,8 @@ struct PlayResult {
   std::uint64_t published = 0;
   std::map<std::string, std::uint64_t> per_topic;  ///< by published (remapped) name
   std::vector<std::string> skipped;                ///< channels not played, with the reason
+  std::vector<std::string> skipped_chunks;         ///< corrupt chunks left out, with the reason
+  std::uint64_t gaps_shortened = 0;                ///< gaps above max_gap_s (every pass)
 };
 
 /// Plays `options.file`; returns when done or stopped. Throws runtime::Error naming the file

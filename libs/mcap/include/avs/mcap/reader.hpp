@@ -11,6 +11,7 @@
 #include <set>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "avs/mcap/records.hpp"
 #include "avs/mcap/status.hpp"
@@ -18,11 +19,27 @@
 namespace avs::mcap {
 
 struct ReaderOptions {
-  /// Refuse chunks whose uncompressed size exceeds this (protects against hostile sizes).
-  std::uint64_t max_chunk_uncompressed_bytes = 1ull << 30;
+  /// Refuse chunks whose uncompressed size exceeds this (a zstd bomb: a 101 KB file of 8 chunks
+  /// claiming 128 MiB each took 2.4 GB under the old 1 GiB limit). avs writes chunks of
+  /// --chunk-size (4 MiB) plus at most one message, far below.
+  std::uint64_t max_chunk_uncompressed_bytes = 64ull << 20;
+  /// Refuse to hold more than this many uncompressed bytes of chunks at once (the log-time merge
+  /// keeps every chunk overlapping the next message's time loaded).
+  std::uint64_t max_loaded_uncompressed_bytes = 256ull << 20;
   /// Refuse any single record larger than this.
   std::uint64_t max_record_bytes = 2ull << 30;
   bool verify_chunk_crc = true;
+  /// A chunk whose record framing is intact but whose content is not (CRC mismatch, corrupt
+  /// compression, a bad record inside, over the size limits) is skipped, said in the report
+  /// (ScanResult / ReadReport::skipped_chunks), and reading goes on with the next record.
+  /// Off: such a chunk is an error. `bag play` and `bag repair` skip; strict readers do not.
+  bool skip_corrupt_chunks = false;
+};
+
+/// A chunk left out by ReaderOptions::skip_corrupt_chunks, and why.
+struct SkippedChunk {
+  std::uint64_t offset = 0;  ///< of the Chunk record
+  std::string problem;       ///< the error reading it would have been
 };
 
 struct ReadOptions {
@@ -44,6 +61,7 @@ struct ReadReport {
   std::uint64_t truncated_at = 0;  ///< offset of the first incomplete record
   std::string truncation_detail;
   std::uint64_t messages_delivered = 0;
+  std::vector<SkippedChunk> skipped_chunks;  ///< with ReaderOptions::skip_corrupt_chunks
 };
 
 /// What a linear scan of the data section found.
@@ -57,6 +75,9 @@ struct ScanResult {
   std::string truncation_detail;
   std::uint64_t loose_message_count = 0;  ///< Message records outside chunks
   bool data_crc_checked = false;          ///< Data End carried a CRC and it matched
+  /// With ReaderOptions::skip_corrupt_chunks: the chunks left out (the data section CRC then
+  /// cannot match and is not an error).
+  std::vector<SkippedChunk> skipped_chunks;
 };
 
 /// Called per message; return false to stop early.
@@ -112,12 +133,23 @@ struct RepairReport {
   std::uint64_t bytes_dropped = 0;  ///< input bytes after the last record kept
   /// Why the scan stopped early (truncation, CRC mismatch, ...); empty when it reached Data End.
   std::string stopped_because;
+  /// Chunks left out because their content is corrupt (the records after them are kept).
+  std::vector<SkippedChunk> skipped_chunks;
+  /// The input's own summary's message count, when it had a valid one.
+  std::uint64_t input_summary_messages = 0;
+  /// Where the result is: `output`, or `<output>.repaired.mcap` when it would have replaced
+  /// the input but is not complete.
+  std::filesystem::path written_to;
 };
 
 /// Rewrites `input` into `output` with fresh Message Indexes, Data End, summary and footer,
-/// from a linear scan: keeps every complete, valid record up to the first incomplete or corrupt
-/// one (everything after it is dropped and reported).
-/// `output` may equal `input` (written to a temporary file, then renamed).
+/// from a linear scan: keeps every complete, valid record up to the first incomplete one;
+/// a chunk whose framing is intact but whose content is corrupt is left out (reported) and the
+/// scan goes on. The result is read back (summary, CRCs, message count) before it is kept.
+/// `output` may equal `input`: the input is then replaced only when the result is complete
+/// (no chunk left out; as many messages as the input's valid summary counts) and verified;
+/// otherwise the result stays at `<output>.repaired.mcap` (report.written_to), the input is
+/// untouched and the status says so (StatusCode::incomplete).
 Status repair_file(const std::filesystem::path& input, const std::filesystem::path& output,
                    RepairReport& report);
 

@@ -16,6 +16,7 @@ enum class StatusCode {
   crc_mismatch,      ///< a chunk, data-section or summary CRC does not match
   unsupported,       ///< valid MCAP that this library does not handle (e.g. unknown compression)
   too_large,         ///< a size above the reader's configured limits
+  incomplete,        ///< repair: the result lacks part of the input, so it did not replace it
 };
 
 const char* status_code_name(StatusCode code);

@@ -11,7 +11,7 @@
 namespace avs::testing {
 
 /// Takes every DiagnosticArray `reader` holds and calls fn(status) for each DiagnosticStatus
-/// named `name` ("container/component"), in arrival order.
+/// named `name` ("container/component"; empty: every status), in arrival order.
 template <class Fn>
 void take_diagnostic_statuses(const runtime::dds::Reader& reader, std::string_view name, Fn fn) {
   using Array = msgs::diagnostic_msgs::DiagnosticArray;
@@ -22,7 +22,7 @@ void take_diagnostic_statuses(const runtime::dds::Reader& reader, std::string_vi
     if (dds_take(reader.get(), buffers, &info, 1, 1) <= 0) break;
     if (!info.valid_data) continue;
     for (const auto& status : runtime::as_span(sample->status)) {
-      if (runtime::get_string(status.name) == name) fn(status);
+      if (name.empty() || runtime::get_string(status.name) == name) fn(status);
     }
   }
 }
