@@ -6,9 +6,13 @@
 // configuration). A device that is absent, times out or is unplugged never stops the graph: it
 // is reported (log, /diagnostics), reopened every reconnect_period_ms and configured again.
 // `transport: emulator` drives avs's DLPC350 emulator instead (no hardware: tests, sim rigs).
+// /projector/link_state (std_msgs/String, latched) says "running", "disconnected" or "refused"
+// on every change.
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "avs/projector/dlpc350_emulator.hpp"
 #include "avs/projector/projector_link.hpp"
@@ -31,7 +35,10 @@ struct ProjectorConfig {
   int vendor_id = kUsbVendorId;
   int product_id = kUsbProductId;
   std::string serial;
-  SequenceConfig sequence;
+  int bit_count = 9;              ///< n: 2n patterns per cycle (the camera's bit_count)
+  double pattern_rate_hz = 1000;  ///< the camera's frame_rate_hz: one fact for both
+  int exposure_us = 0;            ///< 0: the whole pattern period
+  SequenceConfig sequence;        ///< the rest of the sequence (counts and times from above)
   int usb_timeout_ms = 200;
   int reconnect_period_ms = 1000;
   int status_period_ms = 1000;
@@ -62,9 +69,18 @@ class ProjectorComponent final : public runtime::Component {
                 "the flash pattern sequence, trigger out 1 to the camera; reconnects when the "
                 "device comes back; `transport: emulator` for avs's DLPC350 emulator",
             .parameters = params().specs_with({}),
-            .publishes = {},
+            .publishes = {runtime::port<msgs::std_msgs::String>(
+                "link_state", "/projector/link_state", latched())},
             .subscribes = {},
             .default_mismatches = [] { return params().default_mismatches(); }};
+  }
+
+  /// The last link state for late joiners too.
+  static runtime::QosProfile latched() {
+    runtime::QosProfile q;
+    q.durability = runtime::Durability::transient_local;
+    q.depth = 1;
+    return q;
   }
 
   static const runtime::ConfigParams<ProjectorConfig>& params() {
@@ -79,12 +95,14 @@ class ProjectorComponent final : public runtime::Component {
             .integer("product_id", AVS_FIELD(product_id), 0, 65535, "",
                      "USB product id (LightCrafter 4500: 0x6401)")
             .string("serial", AVS_FIELD(serial), "USB serial number; empty: the first found")
-            .integer("pattern_count", AVS_FIELD(sequence.pattern_count), 1, 128, "",
-                     "1-bit patterns per cycle (2n, `avs patterns`' order)")
-            .integer("exposure_us", AVS_FIELD(sequence.exposure_us), 1, 1e8, "us",
-                     "pattern exposure")
-            .integer("frame_period_us", AVS_FIELD(sequence.frame_period_us), 1, 1e8, "us",
-                     "pattern period: equal to the exposure or >= exposure + 230 us")
+            .integer("bit_count", AVS_FIELD(bit_count), 1, 64, "",
+                     "n code bits: 2n 1-bit patterns per cycle in `avs patterns`' order (the "
+                     "camera's and decode's bit_count)")
+            .real("pattern_rate_hz", AVS_FIELD(pattern_rate_hz), 0.01, 1e6, "Hz",
+                  "patterns per second (the camera's frame_rate_hz); the period 1e6 / rate "
+                  "must be whole microseconds")
+            .integer("exposure_us", AVS_FIELD(exposure_us), 0, 1e8, "us",
+                     "pattern exposure; 0: the whole period (else <= period - 230 us)")
             .choice("led", AVS_FIELD(sequence.led),
                     std::vector<std::pair<std::string, Led>>{{"white", Led::kWhite},
                                                              {"red", Led::kRed},
@@ -118,7 +136,9 @@ class ProjectorComponent final : public runtime::Component {
   }
 
   explicit ProjectorComponent(ComponentContext& ctx)
-      : Component(ctx), config_(params().make(ctx.parameters())) {
+      : Component(ctx),
+        config_(make_config(ctx)),
+        link_state_(ctx.publisher<msgs::std_msgs::String>("link_state")) {
     if (const std::string problem = check(config_.sequence); !problem.empty()) {
       throw runtime::Error("projector: " + problem);
     }
@@ -133,6 +153,7 @@ class ProjectorComponent final : public runtime::Component {
 
   void on_activate() override {
     activated_ = steady_now();
+    publish_link_state();
     timer_ = context().create_timer(std::chrono::milliseconds(50), [this] { tick(); });
   }
 
@@ -148,7 +169,7 @@ class ProjectorComponent final : public runtime::Component {
     const LinkCounters& c = link_->counters();
     const auto text = [](std::uint64_t v) { return std::to_string(v); };
     return {{"transport", config_.transport == TransportKind::kHid ? "hid" : "emulator"},
-            {"state", link_state_name(link_->state())},
+            {"link_state", link_state_name(link_->state())},
             {"device", link_->device_description()},
             {"connects", text(c.connects)},
             {"connect_failures", text(c.connect_failures)},
@@ -164,6 +185,20 @@ class ProjectorComponent final : public runtime::Component {
   }
 
  private:
+  static ProjectorConfig make_config(ComponentContext& ctx) {
+    ProjectorConfig c = params().make(ctx.parameters());
+    const double period_us = 1e6 / c.pattern_rate_hz;
+    if (std::abs(period_us - std::round(period_us)) > 1e-6) {
+      throw runtime::Error("projector: pattern_rate_hz " + std::to_string(c.pattern_rate_hz) +
+                           " gives a period of " + std::to_string(period_us) +
+                           " us; the DLPC350 takes whole microseconds");
+    }
+    c.sequence.pattern_count = 2 * c.bit_count;
+    c.sequence.frame_period_us = static_cast<int>(std::lround(period_us));
+    c.sequence.exposure_us = c.exposure_us > 0 ? c.exposure_us : c.sequence.frame_period_us;
+    return c;
+  }
+
   TransportOpener make_opener(ComponentContext& ctx) {
     if (config_.transport == TransportKind::kEmulator) {
       log().warn(
@@ -203,8 +238,25 @@ class ProjectorComponent final : public runtime::Component {
   void tick() {
     const SteadyTime now = steady_now();
     if (emulator_) apply_emulator_schedule(now - activated_);
-    std::lock_guard lock(mutex_);
-    log_events(link_->step(now));
+    {
+      std::lock_guard lock(mutex_);
+      log_events(link_->step(now));
+    }
+    publish_link_state();
+  }
+
+  /// /projector/link_state on every change ("disconnected", "running", "refused").
+  void publish_link_state() {
+    LinkState state{};
+    {
+      std::lock_guard lock(mutex_);
+      state = link_->state();
+    }
+    if (published_state_ && *published_state_ == state) return;
+    published_state_ = state;
+    auto m = runtime::make_sample<msgs::std_msgs::String>();
+    runtime::set_string(m->data, link_state_name(state));
+    link_state_.publish(std::move(m));
   }
 
   void apply_emulator_schedule(std::chrono::nanoseconds since_start) {
@@ -238,6 +290,8 @@ class ProjectorComponent final : public runtime::Component {
   }
 
   ProjectorConfig config_;
+  runtime::Publisher<msgs::std_msgs::String> link_state_;
+  std::optional<LinkState> published_state_;
   std::shared_ptr<Dlpc350Emulator> emulator_;
   runtime::TimerId timer_ = 0;
   SteadyTime activated_{};
