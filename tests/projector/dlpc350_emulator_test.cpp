@@ -147,6 +147,12 @@ TEST(Dlpc350Emulator, ALateReplyIsNotTakenForTheNextRequest) {
   // must get its own reply, not the stale one.
   EXPECT_THROW((void)bench.client.read(Command::kHardwareStatus, 1), Dlpc350Error);
   EXPECT_EQ(bench.client.read(Command::kMainStatus, 1), std::vector<std::uint8_t>{0x02});
+
+  // Without matching, the stale reply is taken: what match_reply_sequence guards against.
+  Dlpc350Client unmatched(*bench.transport, milliseconds(100), /*match_sequence=*/false);
+  bench.device->delay_next_reply();
+  EXPECT_THROW((void)unmatched.read(Command::kHardwareStatus, 1), Dlpc350Error);
+  EXPECT_EQ(unmatched.read(Command::kMainStatus, 1), std::vector<std::uint8_t>{0x01});
 }
 
 TEST(Dlpc350Emulator, RepeatedTimeoutsCloseAndReopenTheDevice) {

@@ -21,8 +21,11 @@ std::string DeviceStatus::words() const {
 }
 
 Dlpc350Client::Dlpc350Client(HidTransport& transport, std::chrono::milliseconds usb_timeout,
-                             int max_stale_replies)
-    : transport_(transport), usb_timeout_(usb_timeout), max_stale_replies_(max_stale_replies) {}
+                             bool match_sequence, int max_stale_replies)
+    : transport_(transport),
+      usb_timeout_(usb_timeout),
+      match_sequence_(match_sequence),
+      max_stale_replies_(max_stale_replies) {}
 
 Reply Dlpc350Client::transact(Request request) {
   request.sequence = next_sequence_++;
@@ -51,7 +54,7 @@ Reply Dlpc350Client::transact(Request request) {
     if (!decoded.reply) {
       throw Dlpc350Error(Kind::kBadReply, context(request) + ": " + decoded.error);
     }
-    if (decoded.reply->sequence != request.sequence) continue;
+    if (match_sequence_ && decoded.reply->sequence != request.sequence) continue;
     if (decoded.reply->nack) {
       throw Dlpc350Error(Kind::kNack, context(request) +
                                           ": the controller answered NACK "
@@ -61,7 +64,9 @@ Reply Dlpc350Client::transact(Request request) {
   }
   throw Dlpc350Error(Kind::kBadReply, context(request) + ": " +
                                           std::to_string(max_stale_replies_ + 1) +
-                                          " replies, none with this sequence number");
+                                          " replies, none with this sequence number (a "
+                                          "controller that does not echo it: "
+                                          "match_reply_sequence: false)");
 }
 
 void Dlpc350Client::write(Command command, std::vector<std::uint8_t> data) {

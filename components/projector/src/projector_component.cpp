@@ -43,6 +43,7 @@ struct ProjectorConfig {
   int reconnect_period_ms = 1000;
   int status_period_ms = 1000;
   int timeouts_before_lost = 3;
+  bool match_reply_sequence = true;
   int emulator_flash_images = 1;
   double emulator_unplug_at_s = -1;  ///< emulator only: unplug this long after activation
   double emulator_replug_at_s = -1;  ///< ... and plug back in
@@ -55,6 +56,7 @@ LinkConfig link_config(const ProjectorConfig& c) {
   l.reconnect_period = std::chrono::milliseconds(c.reconnect_period_ms);
   l.status_period = std::chrono::milliseconds(c.status_period_ms);
   l.timeouts_before_lost = c.timeouts_before_lost;
+  l.match_reply_sequence = c.match_reply_sequence;
   return l;
 }
 
@@ -126,6 +128,9 @@ class ProjectorComponent final : public runtime::Component {
                      "between status read-backs")
             .integer("timeouts_before_lost", AVS_FIELD(timeouts_before_lost), 1, 1000, "",
                      "consecutive timeouts after which the device is reopened")
+            .boolean("match_reply_sequence", AVS_FIELD(match_reply_sequence),
+                     "skip replies whose sequence number is not the request's (late replies); "
+                     "false if the firmware does not echo it (not verified on a DLPC350)")
             .integer("emulator_flash_images", AVS_FIELD(emulator_flash_images), 0, 256, "",
                      "emulator: images in its flash")
             .real("emulator_unplug_at_s", AVS_FIELD(emulator_unplug_at_s), -1.0, 1e6, "s",

@@ -92,7 +92,8 @@ void ProjectorLink::connect(std::vector<LinkEvent>& events) {
   }
   open_failure_reported_ = false;
   description_ = transport_->description();
-  client_ = std::make_unique<Dlpc350Client>(*transport_, config_.usb_timeout);
+  client_ = std::make_unique<Dlpc350Client>(*transport_, config_.usb_timeout,
+                                            config_.match_reply_sequence);
   try {
     const DeviceStatus status = client_->read_status();
     status_words_ = status.words();

@@ -41,10 +41,12 @@ struct DeviceStatus {
 
 class Dlpc350Client {
  public:
-  /// `usb_timeout`: how long one reply may take. `max_stale_replies`: replies with another
-  /// sequence number (late answers to a request that timed out) skipped before giving up.
+  /// `usb_timeout`: how long one reply may take. `match_sequence`: skip replies with another
+  /// sequence number (late answers to a request that timed out), at most `max_stale_replies`
+  /// of them; TI documents the echo for the DLPC900 and its host code numbers DLPC350 writes,
+  /// but no DLPC350 document here says the DLPC350 echoes it: false takes any reply.
   Dlpc350Client(HidTransport& transport, std::chrono::milliseconds usb_timeout,
-                int max_stale_replies = 4);
+                bool match_sequence = true, int max_stale_replies = 4);
 
   /// A write the controller acknowledges (throws on NACK, timeout, disconnection).
   void write(Command command, std::vector<std::uint8_t> data);
@@ -64,6 +66,7 @@ class Dlpc350Client {
 
   HidTransport& transport_;
   std::chrono::milliseconds usb_timeout_;
+  bool match_sequence_;
   int max_stale_replies_;
   std::uint8_t next_sequence_ = 0;
 };

@@ -28,6 +28,7 @@ struct LinkConfig {
   std::chrono::milliseconds status_period{1000};     ///< between status read-backs
   int timeouts_before_lost = 3;  ///< consecutive timeouts after which the device is reopened
   int max_validate_polls = 100;  ///< LUT_VALID reads while the controller is busy
+  bool match_reply_sequence = true;  ///< Dlpc350Client's match_sequence
 };
 
 enum class LinkState : std::uint8_t {
