@@ -152,7 +152,8 @@ int write_patterns(const PatternsOptions& o, Command& cmd) {
               << '\n';
     return 1;
   }
-  std::cout << "wrote " << (n + 23) / 24 << " LightCrafter 4500 flash image(s) "
+  const int images = (n + projector::kPatternsPerImage - 1) / projector::kPatternsPerImage;
+  std::cout << "wrote " << images << " LightCrafter 4500 flash image(s) "
             << "(flash_image_NN.bmp, 24 1-bit patterns each) and lut.csv (its pattern LUT, "
                "first flash image index "
             << o.first_flash_image << ")\n";

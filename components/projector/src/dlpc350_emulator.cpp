@@ -135,6 +135,7 @@ std::optional<Bytes> Dlpc350Emulator::handle_write(const Request& r) {
   State& s = state_;
   const Bytes& d = r.data;
   if (r.command == Command::kMailboxData) {
+    if (s.running) return std::nullopt;  // the guide: stop the sequence before changing it
     if (s.mailbox == 2) {
       if (d.size() % 3 != 0 || s.mailbox_address + d.size() / 3 > 128) return std::nullopt;
       s.lut.resize(std::max<std::size_t>(s.lut.size(), s.mailbox_address + d.size() / 3));
