@@ -7,14 +7,15 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 # What the demo needs (runtime, components, `avs`, report figures; `avs view`: Boost.Beast
-# headers and nlohmann JSON; the `camera` and `sim_camera` components: Aravis 0.8).
+# headers and nlohmann JSON; the `camera` and `sim_camera` components: Aravis 0.8; the
+# `projector` component's USB HID transport: hidapi).
 DEMO_PACKAGES=(
   build-essential cmake pkg-config
   cyclonedds-dev cyclonedds-tools
   libeigen3-dev libyaml-cpp-dev libcli11-dev libnanoflann-dev
   libmodbus-dev libzstd-dev liblz4-dev zlib1g-dev libpng-dev
   libboost-dev nlohmann-json3-dev
-  libaravis-dev
+  libaravis-dev libhidapi-dev
   gnuplot-nox
 )
 # What the tests and benchmarks need on top (peers measured beside ours: OpenCV, PCL;

@@ -1,7 +1,10 @@
 // avs patterns --out DIR: writes the Gray-code projector patterns (Eq. 1, section 4.1) as 8-bit
 // PNG files in projection order (bit 0 = MSB positive, bit 0 negative, bit 1 positive, ...),
 // named so that they sort in that order, plus index.csv saying which file is which bit and
-// polarity, ready to load into a projector's pattern sequence.
+// polarity, ready to load into a projector's pattern sequence. For a DLP LightCrafter 4500
+// (the `projector` component) it also writes what its flash needs: flash_image_NN.bmp, 24-bit
+// images packing 24 1-bit patterns each in the order the pattern LUT uses, and lut.csv, the
+// LUT the component sends (docs/devices.md section 7).
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -13,6 +16,10 @@
 #include "avs/decode/patterns.hpp"
 #include "avs/decode/png_io.hpp"
 #define AVS_HAVE_DECODE 1
+#endif
+#if __has_include("avs/projector/pattern_sequence.hpp")
+#include "avs/projector/pattern_sequence.hpp"
+#define AVS_HAVE_PROJECTOR 1
 #endif
 
 namespace avs::cli {
@@ -28,7 +35,50 @@ struct PatternsOptions {
   int first_row = -1;
   int width = 912;
   int height = 1140;
+  int first_flash_image = 0;
 };
+
+#if defined(AVS_HAVE_DECODE) && defined(AVS_HAVE_PROJECTOR)
+/// The LightCrafter 4500's flash images and the pattern LUT the `projector` component sends
+/// for them (the one LUT: projector::pattern_lut).
+bool write_flash_images(const std::vector<decode::PatternImage>& patterns, int width, int height,
+                        int first_flash_image, const std::filesystem::path& dir) {
+  std::vector<std::vector<std::uint8_t>> pixels;
+  for (const decode::PatternImage& p : patterns) pixels.push_back(p.pixels);
+  const auto images = projector::pack_flash_images(pixels, width, height);
+  for (std::size_t i = 0; i < images.size(); ++i) {
+    char name[64];
+    std::snprintf(name, sizeof name, "flash_image_%02zu.bmp", i);
+    const std::vector<std::uint8_t> bmp = projector::encode_bmp24(images[i]);
+    std::ofstream out(dir / name, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bmp.data()), static_cast<std::streamsize>(bmp.size()));
+    if (!out) return false;
+  }
+  projector::SequenceConfig sequence;
+  sequence.pattern_count = static_cast<int>(patterns.size());
+  sequence.first_flash_image = first_flash_image;
+  std::ofstream lut(dir / "lut.csv");
+  lut << "entry,bit_index,polarity,flash_file,flash_image_index,pattern_number,bit_plane,"
+         "bit_depth,trigger,buffer_swap,trigger_out_previous,lut_bytes\n";
+  const auto entries = projector::pattern_lut(sequence);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const projector::PatternEntry& e = entries[k];
+    const projector::FlashSlot slot = projector::flash_slot(static_cast<int>(k));
+    const auto b = e.encode();
+    char bytes[16];
+    std::snprintf(bytes, sizeof bytes, "%02X %02X %02X", b[0], b[1], b[2]);
+    lut << k << ',' << patterns[k].bit_index << ','
+        << (patterns[k].polarity == decode::Polarity::kPositive ? "positive" : "negative") << ','
+        << "flash_image_" << (slot.image < 10 ? "0" : "") << slot.image << ".bmp,"
+        << first_flash_image + slot.image << ',' << e.pattern_number << ','
+        << projector::plane_name(e.pattern_number) << ',' << e.bit_depth << ','
+        << (e.trigger == projector::TriggerType::kInternal ? "internal" : "external") << ','
+        << (e.buffer_swap ? 1 : 0) << ',' << (e.trigger_out_previous ? 1 : 0) << ',' << bytes
+        << '\n';
+  }
+  return static_cast<bool>(lut);
+}
+#endif
 
 #ifdef AVS_HAVE_DECODE
 int write_patterns(const PatternsOptions& o, Command& cmd) {
@@ -96,6 +146,18 @@ int write_patterns(const PatternsOptions& o, Command& cmd) {
             << " bits, " << layout.code_count << " codes x " << layout.rows_per_code
             << " rows from row " << layout.first_row << ") and index.csv to " << dir.string()
             << '\n';
+#ifdef AVS_HAVE_PROJECTOR
+  if (!write_flash_images(patterns, width, height, o.first_flash_image, dir)) {
+    std::cerr << "avs patterns: cannot write the flash images or lut.csv to " << dir.string()
+              << '\n';
+    return 1;
+  }
+  const int images = (n + projector::kPatternsPerImage - 1) / projector::kPatternsPerImage;
+  std::cout << "wrote " << images << " LightCrafter 4500 flash image(s) "
+            << "(flash_image_NN.bmp, 24 1-bit patterns each) and lut.csv (its pattern LUT, "
+               "first flash image index "
+            << o.first_flash_image << ")\n";
+#endif
   return 0;
 }
 #endif
@@ -104,7 +166,8 @@ void add_patterns_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "patterns",
       "Write the Gray-code projector patterns (Eq. 1) as PNG files in projection order "
-      "(bit 0 positive, bit 0 negative, ...) with index.csv");
+      "(bit 0 positive, bit 0 negative, ...) with index.csv, and the LightCrafter 4500's flash "
+      "images (24 patterns per 24-bit BMP) with lut.csv");
   static PatternsOptions o;
   cmd->add_option("--out", o.out, "output folder (created)")->required();
   cmd->add_option("--calibration", o.calibration,
@@ -121,6 +184,11 @@ void add_patterns_command(Command& app) {
   cmd->add_option("--height", o.height, "projector height, pixels")
       ->capture_default_str()
       ->check_range(1, 16384);
+  cmd->add_option("--first-flash-image", o.first_flash_image,
+                  "LightCrafter 4500: flash image index where flash_image_00.bmp is stored "
+                  "(the projector component's first_flash_image)")
+      ->capture_default_str()
+      ->check_range(0, 255);
   cmd->callback([cmd] {
 #ifdef AVS_HAVE_DECODE
     try {
