@@ -3,8 +3,9 @@
 option(AVS_WERROR "Treat compiler warnings as errors" OFF)
 function(avs_apply_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-missing-field-initializers
-    # GCC 12 reports false -Wrestrict positives inside std::string (GCC bug 105329).
-    -Wno-restrict)
+    # GCC 12 reports false -Wrestrict positives inside std::string (GCC bug 105329); clang
+    # (the fuzz build) has no such option.
+    $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict>)
   # A unity build includes .cpp files into one another: GCC then reports types of a file's
   # anonymous namespace used by its own classes as if they came from a header.
   if(CMAKE_UNITY_BUILD)

@@ -33,5 +33,16 @@ TEST(CalibrationYaml, ErrorsNameSourceAndLine) {
   EXPECT_THROW(load_sensor_geometry_yaml("/nonexistent/calib.yaml"), std::runtime_error);
 }
 
+// Found by tests/fuzz (fuzz_calibration): a list as a key gave yaml-cpp's "bad conversion"
+// without the file.
+TEST(CalibrationYaml, ListAsAKeyIsALocatedError) {
+  try {
+    parse_sensor_geometry_yaml("camera: {fx: 600,\n  [1, 2]}\n", "calib.yaml");
+    FAIL() << "a list as a key accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), "calib.yaml:2:3: a key in camera is not a name");
+  }
+}
+
 }  // namespace
 }  // namespace avs::decode

@@ -303,6 +303,12 @@ TEST_F(GraphTest, SecondYamlDocumentIsAnErrorNotIgnored) {
   expect_one_error("two_documents.yaml", 6, 1, {"second YAML document"});
 }
 
+// Found by tests/fuzz (fuzz_graph_loader): yaml-cpp's LoadAll never returned on these.
+TEST_F(GraphTest, CommaWhereADocumentMayStartIsALocatedErrorNotAHang) {
+  expect_one_error("comma_document.yaml", 1, 1, {"','"});
+  expect_one_error("comma_after_document.yaml", 1, 18, {"','"});
+}
+
 /// A fresh folder for generated graphs, removed with the object.
 struct TempDir {
   std::filesystem::path path =

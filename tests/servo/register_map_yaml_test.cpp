@@ -66,6 +66,16 @@ TEST(RegisterMapYaml, BadWordOrderIsOneClearLine) {
   EXPECT_EQ(error.find('\n'), std::string::npos) << error;
 }
 
+// Found by tests/fuzz (fuzz_register_map): yaml-cpp's "bad conversion" without a file escaped.
+TEST(RegisterMapYaml, ListsAndMapsWhereANameBelongsAreLocatedErrors) {
+  EXPECT_EQ(error_of("word_order: [high_first]\nregisters: {controlword: {address: 0}}\n"),
+            "servo.yaml:1:13: register (default): word_order must be a name");
+  EXPECT_EQ(error_of("registers: {[controlword]: {address: 0}}\n"),
+            "servo.yaml:1:13: a register name is not a name");
+  EXPECT_EQ(error_of("registers: {controlword: {{address: 0}: 1}}\n"),
+            "servo.yaml:1:27: register controlword: a key is not a name");
+}
+
 TEST(RegisterMapYaml, OtherMistakesNameTheRegister) {
   EXPECT_NE(
       error_of("registers:\n  controlword: {address: 0, size: 24}\n").find("size must be 16 or 32"),

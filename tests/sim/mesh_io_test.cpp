@@ -137,5 +137,25 @@ TEST_F(MeshIoTest, TruncatedBinaryPlyAndBadIndicesAreReported) {
   EXPECT_NE(error_of(path("bad.ply")).find("triangle 3 uses vertex 99"), std::string::npos);
 }
 
+// Found by tests/fuzz (fuzz_ply_mesh): a float list length of 2.96e29 was cast to an integer
+// (undefined behaviour); lengths and indices must be whole numbers in range.
+TEST_F(MeshIoTest, PlyListLengthsAndIndicesMustBeWholeNumbersInRange) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list float int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n";
+  EXPECT_NE(error_of(write("l.ply", header + "2.96e29 0 1 2\n"))
+                .find("l.ply:13: list length 2.96e+29 is not a whole number"),
+            std::string::npos)
+      << error_of(path("l.ply"));
+  EXPECT_NE(error_of(write("f.ply", header + "3.5 0 1 2\n"))
+                .find("f.ply:13: list length 3.5 is not a whole number"),
+            std::string::npos)
+      << error_of(path("f.ply"));
+  EXPECT_NE(error_of(write("n.ply", header + "3 0 1 1e12\n")).find("n.ply:13: list item 1e+12"),
+            std::string::npos)
+      << error_of(path("n.ply"));
+}
+
 }  // namespace
 }  // namespace avs::geometry

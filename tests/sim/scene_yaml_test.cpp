@@ -97,5 +97,14 @@ TEST(SceneYaml, ErrorsNameFileLineAndColumn) {
             std::string::npos);
 }
 
+// Found by tests/fuzz (fuzz_scene): yaml-cpp's "operator[] call on a scalar" without the file.
+TEST(SceneYaml, WrongNodeKindsAreLocatedErrors) {
+  EXPECT_EQ(error_of("objects:\n  - cube\n"),
+            "test.yaml:2:5: an object is a map (name, model/mesh/plane, ...)");
+  EXPECT_EQ(error_of("objects:\n  - {model: cube, trajectory: static}\n").rfind("test.yaml:2:", 0),
+            0u);
+  EXPECT_EQ(error_of("sensor: 3\nobjects: []\n").rfind("test.yaml:1:", 0), 0u);
+}
+
 }  // namespace
 }  // namespace avs::sim

@@ -70,9 +70,7 @@ void write_lens(YAML::Emitter& out, const char* name, const geometry::CameraMode
   out << YAML::EndMap;
 }
 
-}  // namespace
-
-SensorGeometry parse_sensor_geometry_yaml(const std::string& text, const std::string& source) {
+SensorGeometry parse_root(const std::string& text, const std::string& source) {
   const YAML::Node root = runtime::yaml_parse(text, source);
   SensorGeometry g = default_sensor_geometry();
   if (!root || root.IsNull()) return g;
@@ -108,6 +106,16 @@ SensorGeometry parse_sensor_geometry_yaml(const std::string& text, const std::st
     }
   }
   return g;
+}
+
+}  // namespace
+
+SensorGeometry parse_sensor_geometry_yaml(const std::string& text, const std::string& source) {
+  try {
+    return parse_root(text, source);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(runtime::yaml_error_message(source, e));
+  }
 }
 
 SensorGeometry load_sensor_geometry_yaml(const std::string& path) {

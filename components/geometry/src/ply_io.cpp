@@ -1,8 +1,10 @@
 // PLY reader (ASCII and binary little-endian) and binary writer.
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -164,6 +166,28 @@ Header read_header(std::istream& in, const std::string& path) {
   detail::fail(path, header.lines, "file ends inside the header (no end_header)");
 }
 
+/// `value` (a list length or a vertex index, stored in any PLY type) as a whole number in
+/// [min, max]; anything else (2.96e29 as a length, found by tests/fuzz) is an error, not a cast
+/// out of range.
+long long whole_number(double value, double min, double max, const std::string& path,
+                       std::size_t line, const std::string& what) {
+  if (!(value >= min && value <= max) || value != std::floor(value)) {
+    std::ostringstream text;
+    text << what << " " << value << " is not a whole number in [" << min << ", " << max << "]";
+    detail::fail(path, line, text.str());
+  }
+  return static_cast<long long>(value);
+}
+
+/// A list length and a vertex index as whole_number() accepts them.
+long long list_length(double value, const std::string& path, std::size_t line) {
+  return whole_number(value, 0, std::numeric_limits<int>::max(), path, line, "list length");
+}
+int vertex_index(double value, const std::string& path, std::size_t line) {
+  return static_cast<int>(whole_number(value, std::numeric_limits<int>::min(),
+                                       std::numeric_limits<int>::max(), path, line, "list item"));
+}
+
 /// Collects one element item's values; list values go to `list`.
 struct ItemSink {
   std::vector<double> scalars;  ///< one per non-list property, in order
@@ -215,12 +239,11 @@ void read_ascii_body(std::istream& in, const Header& header, Mesh& mesh, const s
           item.scalars.push_back(value);
           continue;
         }
-        const auto count = static_cast<long long>(value);
-        if (count < 0) detail::fail(path, line_number, "negative list length");
+        const long long count = list_length(value, path, line_number);
         item.list.clear();
         for (long long k = 0; k < count; ++k) {
           if (!(words >> value)) detail::fail(path, line_number, "list shorter than its length");
-          item.list.push_back(static_cast<int>(value));
+          item.list.push_back(vertex_index(value, path, line_number));
         }
       }
       add_item(element, item, mesh, path, line_number);
@@ -250,14 +273,14 @@ void read_binary_body(std::istream& in, const Header& header, Mesh& mesh, const 
           continue;
         }
         need(scalar_size(property.count_type), element);
-        const auto count =
-            static_cast<long long>(decode_scalar(property.count_type, body.data() + offset));
+        const long long count =
+            list_length(decode_scalar(property.count_type, body.data() + offset), path, 0);
         offset += scalar_size(property.count_type);
-        if (count < 0) detail::fail(path, 0, "negative list length in '" + element.name + "'");
         need(static_cast<std::size_t>(count) * scalar_size(property.type), element);
         item.list.clear();
         for (long long k = 0; k < count; ++k) {
-          item.list.push_back(static_cast<int>(decode_scalar(property.type, body.data() + offset)));
+          item.list.push_back(
+              vertex_index(decode_scalar(property.type, body.data() + offset), path, 0));
           offset += scalar_size(property.type);
         }
       }

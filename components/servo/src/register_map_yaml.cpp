@@ -25,7 +25,9 @@ std::string known_signals() {
 
 WordOrder parse_word_order(const YAML::Node& node, std::string_view source,
                            const std::string& register_name) {
-  const std::string text = node.as<std::string>();
+  if (!node.IsScalar())
+    fail(source, node, "register " + register_name + ": word_order must be a name");
+  const std::string& text = node.Scalar();
   if (text == "high_first") return WordOrder::high_first;
   if (text == "low_first") return WordOrder::low_first;
   fail(source, node,
@@ -41,7 +43,8 @@ RegisterSpec parse_spec(const YAML::Node& node, std::string_view source, const s
   spec.word_order = default_order;
   bool have_address = false;
   for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) fail(source, kv.first, "register " + name + ": a key is not a name");
+    const std::string& key = kv.first.Scalar();
     const YAML::Node& value = kv.second;
     try {
       if (key == "address") {
@@ -75,9 +78,7 @@ RegisterSpec parse_spec(const YAML::Node& node, std::string_view source, const s
   return spec;
 }
 
-}  // namespace
-
-RegisterMap parse_register_map(const YAML::Node& root, std::string_view source) {
+RegisterMap parse_map(const YAML::Node& root, std::string_view source) {
   if (!root.IsMap()) fail(source, root, "register map: expected a map with 'registers'");
   WordOrder default_order = WordOrder::high_first;
   if (root["word_order"]) default_order = parse_word_order(root["word_order"], source, "(default)");
@@ -85,7 +86,8 @@ RegisterMap parse_register_map(const YAML::Node& root, std::string_view source) 
   if (!registers || !registers.IsMap()) fail(source, root, "register map: missing 'registers' map");
   RegisterMap map;
   for (const auto& kv : registers) {
-    const std::string name = kv.first.as<std::string>();
+    if (!kv.first.IsScalar()) fail(source, kv.first, "a register name is not a name");
+    const std::string& name = kv.first.Scalar();
     const std::optional<Signal> signal = signal_from_name(name);
     if (!signal) {
       fail(source, kv.first, "unknown register '" + name + "' (known: " + known_signals() + ")");
@@ -98,6 +100,16 @@ RegisterMap parse_register_map(const YAML::Node& root, std::string_view source) 
     fail(source, registers, e.what());
   }
   return map;
+}
+
+}  // namespace
+
+RegisterMap parse_register_map(const YAML::Node& root, std::string_view source) {
+  try {
+    return parse_map(root, source);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(runtime::yaml_error_message(std::string(source), e));
+  }
 }
 
 RegisterMap parse_register_map_string(const std::string& yaml_text, std::string_view source) {

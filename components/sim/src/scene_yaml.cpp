@@ -206,10 +206,8 @@ class Parser {
   std::map<std::string, std::shared_ptr<const geometry::Mesh>> cache_;
 };
 
-}  // namespace
-
-SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_errors,
-                      const std::string& base_dir, const std::string& models_dir) {
+SceneFile parse_root(const std::string& yaml_text, const std::string& name_for_errors,
+                     const std::string& base_dir, const std::string& models_dir) {
   const YAML::Node root = runtime::yaml_parse(yaml_text, name_for_errors);
   Parser parser(name_for_errors, base_dir, models_dir);
   if (!root.IsMap()) parser.fail(root, "a scene file is a map with an 'objects' list");
@@ -219,6 +217,7 @@ SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_
   const YAML::Node objects = root["objects"];
   if (!objects || !objects.IsSequence()) parser.fail(root, "missing 'objects' list");
   for (const YAML::Node& node : objects) {
+    if (!node.IsMap()) parser.fail(node, "an object is a map (name, model/mesh/plane, ...)");
     SceneObject object;
     object.name =
         parser.get<std::string>(node, "name", "object" + std::to_string(file.scene.objects.size()));
@@ -231,6 +230,17 @@ SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_
     file.scene.objects.push_back(std::move(object));
   }
   return file;
+}
+
+}  // namespace
+
+SceneFile parse_scene(const std::string& yaml_text, const std::string& name_for_errors,
+                      const std::string& base_dir, const std::string& models_dir) {
+  try {
+    return parse_root(yaml_text, name_for_errors, base_dir, models_dir);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(runtime::yaml_error_message(name_for_errors, e));
+  }
 }
 
 SceneFile load_scene(const std::string& path, const std::string& models_dir) {

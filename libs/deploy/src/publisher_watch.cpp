@@ -69,8 +69,10 @@ void PublisherWatch::run() {
       dds_return_loan(reader_, samples, n);
     }
     for (auto& [topic, last] : reported) {
-      const int live = static_cast<int>(std::count_if(
-          writers.begin(), writers.end(), [&](const auto& w) { return w.second == topic; }));
+      // [&name = topic]: clang 14 (the fuzz build) cannot capture a structured binding.
+      const int live = static_cast<int>(
+          std::count_if(writers.begin(), writers.end(),
+                        [&name = topic](const auto& w) { return w.second == name; }));
       if (last < 0 && live == 0) continue;  // never seen yet: nothing to report
       // Report the first writer seen, every loss of the last writer, and every return.
       if (last <= 0 ? live > 0 : live == 0) callback_(Event{topic, live, live == 0});

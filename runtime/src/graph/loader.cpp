@@ -218,19 +218,24 @@ std::optional<YAML::Node> parse_yaml(LoadState& state, const std::string& path) 
   std::stringstream text;
   text << in.rdbuf();
   try {
-    // Every document is read so that a second one ('---') is an error, not silently ignored.
-    std::vector<YAML::Node> documents = YAML::LoadAll(text.str());
-    if (documents.empty()) return YAML::Node();
-    if (documents.size() > 1) {
-      const YAML::Mark mark = documents[1].Mark();
+    // A second document ('---') is an error, not silently ignored.
+    std::optional<YAML::Mark> second;
+    const std::string all = text.str();
+    YAML::Node document = load_first_document(all, second);
+    if (second) {
+      const SourceLocation where = second->is_null()
+                                       ? SourceLocation{path, 1, 1}
+                                       : SourceLocation{path, second->line + 1, second->column + 1};
+      const bool comma = !second->is_null() && second->pos >= 0 &&
+                         static_cast<std::size_t>(second->pos) < all.size() &&
+                         all[static_cast<std::size_t>(second->pos)] == ',';
       state.diags.error(
-          mark.is_null() ? SourceLocation{path, 1, 1}
-                         : SourceLocation{path, mark.line + 1, mark.column + 1},
-          "a second YAML document in a graph file (after '---'); a graph is one document, "
-          "use 'include' for more files");
+          where, comma ? "YAML syntax error: ',' outside a flow collection ([...] or {...})"
+                       : "a second YAML document in a graph file (after '---'); a graph is one "
+                         "document, use 'include' for more files");
       return std::nullopt;
     }
-    return documents.front();
+    return document;
   } catch (const YAML::Exception& e) {
     const SourceLocation where = e.mark.is_null()
                                      ? SourceLocation{path, 1, 1}

@@ -4,11 +4,48 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
+
+#include <yaml-cpp/eventhandler.h>
 
 #include "avs/runtime/parameters.hpp"
 
 namespace avs::graph::detail {
 namespace {
+
+/// Keeps only where the last document parsed starts: its root node, else its '---'.
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::optional<YAML::Mark> last;
+  void OnDocumentStart(const YAML::Mark& mark) override {
+    last = mark;
+    root_seen_ = false;
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { node(mark); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                const std::string&) override {
+    node(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {
+    node(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {
+    node(mark);
+  }
+  void OnMapEnd() override {}
+
+ private:
+  void node(const YAML::Mark& mark) {
+    if (!root_seen_) last = mark;
+    root_seen_ = true;
+  }
+  bool root_seen_ = false;
+};
 
 using runtime::range_text;
 
@@ -245,6 +282,19 @@ std::string node_kind(const YAML::Node& node) {
   if (node.IsSequence()) return node.size() == 0 ? "an empty list" : "a list";
   if (node.IsMap()) return "a mapping";
   return "'" + node.Scalar() + "'";
+}
+
+YAML::Node load_first_document(const std::string& text, std::optional<YAML::Mark>& second) {
+  second.reset();
+  YAML::Node first = YAML::Load(text);  // parses the first document only
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  DocumentStarts starts;
+  if (parser.HandleNextDocument(starts)) {
+    starts.last.reset();
+    if (parser.HandleNextDocument(starts)) second = starts.last.value_or(YAML::Mark::null_mark());
+  }
+  return first;
 }
 
 }  // namespace avs::graph::detail

@@ -95,4 +95,10 @@ bool is_identifier(std::string_view name);
 /// "a list", "a mapping", "a scalar", "nothing".
 std::string node_kind(const YAML::Node& node);
 
+/// The first YAML document of `text`, and in `second` where a second one starts, if any.
+/// Not YAML::LoadAll: yaml-cpp 0.7's never returns on a ',' where a document may start
+/// (`,`, `[1] ,`: it yields null documents without end), so the documents are counted with a
+/// bounded parse. Syntax errors throw YAML::Exception.
+YAML::Node load_first_document(const std::string& text, std::optional<YAML::Mark>& second);
+
 }  // namespace avs::graph::detail

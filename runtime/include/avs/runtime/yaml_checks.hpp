@@ -22,6 +22,13 @@ namespace avs::runtime {
   throw std::runtime_error(yaml_location(source, node.Mark()) + ": " + what);
 }
 
+/// yaml-cpp's own complaint (operator[] on a scalar, a list read as a string, ...) as
+/// "source:line:column: what": for a parser's outermost catch, so that no message without
+/// its file reaches the user (issue 20: found by tests/fuzz).
+inline std::string yaml_error_message(const std::string& source, const YAML::Exception& error) {
+  return yaml_location(source, error.mark) + ": " + error.msg;
+}
+
 /// `text` parsed as one YAML document; a syntax error throws std::runtime_error
 /// "source:line:column: what yaml-cpp says".
 inline YAML::Node yaml_parse(const std::string& text, const std::string& source) {
@@ -47,7 +54,9 @@ inline void yaml_check_keys(const std::string& source, const YAML::Node& node,
                             const std::set<std::string>& allowed, const std::string& section) {
   if (!node.IsMap()) yaml_fail(source, node, section + " must be a map");
   for (const auto& entry : node) {
-    const auto key = entry.first.as<std::string>();
+    if (!entry.first.IsScalar())
+      yaml_fail(source, entry.first, "a key in " + section + " is not a name");
+    const std::string& key = entry.first.Scalar();
     if (!allowed.count(key)) {
       yaml_fail(source, entry.first, "unknown key '" + key + "' in " + section);
     }

@@ -1,6 +1,6 @@
 // libFuzzer target for the MCAP reader: any input must give an error or success, never a
 // crash, leak or out-of-bounds access (built with -fsanitize=fuzzer,address,undefined).
-// Run: mcap_fuzz_reader -max_total_time=60 CORPUS_DIR tests/mcap/data
+// Run: tools/fuzz.sh, or fuzz_mcap_reader -max_total_time=60 NEW_DIR tests/mcap/data
 #include <cstddef>
 #include <cstdint>
 #include <span>
