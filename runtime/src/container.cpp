@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "avs/runtime/dds.hpp"
+#include "avs/runtime/raw_topic.hpp"
 #include "avs/runtime/ros_discovery.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "diagnostic_msgs.h"
@@ -69,6 +70,12 @@ struct Container::Impl {
   Time last_diagnostics{};  ///< clock time of the previous /diagnostics report
   std::unique_ptr<ParameterService> parameter_service;
   std::unique_ptr<RosDiscoveryWriter> ros_discovery;
+  /// Serialised <-> typed samples, per type, for components with open ports.
+  std::map<std::string, std::unique_ptr<dds::CdrCodec>> codecs;
+  const dds::CdrCodec& codec(const msg::TypeEntry& type);
+  /// The DDS type that the graph's components (in any container) declare for the ROS topic
+  /// `ros_name` on a publisher port; empty when none does.
+  std::string declared_type(const std::string& ros_name) const;
 };
 
 namespace {
@@ -210,7 +217,30 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
   void make_subscription(std::string_view port, const msg::TypeEntry& type,
                          std::function<void(std::shared_ptr<const void>)> callback) override;
 
+ public:
+  std::shared_ptr<SerializedPublisher> serialized_publisher(const std::string& ros_topic,
+                                                            const std::string& dds_type,
+                                                            const QosProfile& qos) override;
+  std::string serialized_subscription(
+      const std::string& ros_topic, const std::string& dds_type, const QosProfile& qos,
+      std::function<void(std::span<const std::byte>)> callback) override;
+  void request_stop(const std::string& why) override {
+    log_.info("stopping the container: ", why);
+    container_.scheduler->stop();
+  }
+
  private:
+  /// publisher/subscription: the writer (reader) and local delivery of one topic.
+  TopicEntry& add_publication(const std::string& dds_name, const msg::TypeEntry& type,
+                              const QosProfile& qos);
+  TopicEntry& add_subscription(const std::string& dds_name, const msg::TypeEntry& type,
+                               const QosProfile& qos,
+                               std::function<void(std::shared_ptr<const void>)> callback);
+  /// An open-ports topic: (DDS name after namespace and remaps, its type entry).
+  std::pair<std::string, const msg::TypeEntry*> resolve_open(const std::string& ros_topic,
+                                                             const std::string& dds_type,
+                                                             bool publishing) const;
+
   /// Runs `fn` only while active; an exception fails the container with context.
   std::function<void()> guard(std::function<void()> fn) {
     return [this, fn = std::move(fn)] {
@@ -321,23 +351,22 @@ class LocalPublisher final : public PublisherCore {
 
 }  // namespace
 
-std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view port,
-                                                             const msg::TypeEntry& type) {
+TopicEntry& ComponentHost::add_publication(const std::string& dds_name, const msg::TypeEntry& type,
+                                           const QosProfile& qos) {
   if (container_.running) throw Error("publishers must be created in the constructor");
-  auto [dds_name, qos] = resolve(port, type, true);
   TopicEntry& topic = container_.topic(dds_name, type, qos);
   if (!topic.writer) {
     topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
     topic.latched = qos.durability == Durability::transient_local;
   }
   published.push_back(&topic);
-  return std::make_shared<LocalPublisher>(*container_.scheduler, topic);
+  return topic;
 }
 
-void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntry& type,
-                                      std::function<void(std::shared_ptr<const void>)> callback) {
+TopicEntry& ComponentHost::add_subscription(
+    const std::string& dds_name, const msg::TypeEntry& type, const QosProfile& qos,
+    std::function<void(std::shared_ptr<const void>)> callback) {
   if (container_.running) throw Error("subscriptions must be created in the constructor");
-  auto [dds_name, qos] = resolve(port, type, false);
   TopicEntry& topic = container_.topic(dds_name, type, qos);
   if (!topic.reader)
     topic.reader = std::make_unique<dds::Reader>(container_.participant, *topic.topic, qos);
@@ -346,6 +375,105 @@ void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntr
       {lane_, [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
          guard([&] { cb(std::move(sample)); })();
        }});
+  return topic;
+}
+
+std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view port,
+                                                             const msg::TypeEntry& type) {
+  auto [dds_name, qos] = resolve(port, type, true);
+  return std::make_shared<LocalPublisher>(*container_.scheduler,
+                                          add_publication(dds_name, type, qos));
+}
+
+void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntry& type,
+                                      std::function<void(std::shared_ptr<const void>)> callback) {
+  auto [dds_name, qos] = resolve(port, type, false);
+  add_subscription(dds_name, type, qos, std::move(callback));
+}
+
+std::pair<std::string, const msg::TypeEntry*> ComponentHost::resolve_open(
+    const std::string& ros_topic, const std::string& dds_type, bool publishing) const {
+  const std::string what = std::string(publishing ? "publisher" : "subscription") + " of '" +
+                           ros_topic + "' in component '" + instance_.name + "'";
+  if (!registered_.spec.open_ports) {
+    throw Error(what + ": " + instance_.type + " declares its ports (no open ports)");
+  }
+  const auto remap = instance_.remaps.find(ros_topic);
+  const std::string ros_name = resolve_topic_name(
+      container_.graph.ns, remap != instance_.remaps.end() ? remap->second : ros_topic);
+  const std::string type_name = dds_type.empty() ? container_.declared_type(ros_name) : dds_type;
+  if (type_name.empty()) {
+    throw Error(what + ": no component of the graph publishes " + ros_name +
+                ", so its type is unknown (give it, or publish the topic in the graph)");
+  }
+  const msg::TypeEntry* type = msg::find_type(type_name);
+  if (type == nullptr) throw Error(what + ": type " + type_name + " is not known to this build");
+  return {to_dds_topic_name(ros_name), type};
+}
+
+namespace {
+
+/// Serialised samples in, typed samples to the container's subscribers and to DDS.
+class LocalSerializedPublisher final : public SerializedPublisher {
+ public:
+  LocalSerializedPublisher(Scheduler& scheduler, TopicEntry& topic, const dds::CdrCodec& codec)
+      : typed_(scheduler, topic), codec_(codec) {}
+  void publish(std::span<const std::byte> cdr) override {
+    std::shared_ptr<void> sample;
+    try {
+      sample = codec_.to_sample(cdr);
+    } catch (const std::exception& e) {
+      throw Error(typed_.topic() + ": " + e.what());
+    }
+    typed_.publish(std::move(sample));
+  }
+  const std::string& topic() const override { return typed_.topic(); }
+
+ private:
+  LocalPublisher typed_;
+  const dds::CdrCodec& codec_;
+};
+
+}  // namespace
+
+std::shared_ptr<SerializedPublisher> ComponentHost::serialized_publisher(
+    const std::string& ros_topic, const std::string& dds_type, const QosProfile& qos) {
+  auto [dds_name, type] = resolve_open(ros_topic, dds_type, true);
+  const dds::CdrCodec& codec = container_.codec(*type);
+  return std::make_shared<LocalSerializedPublisher>(*container_.scheduler,
+                                                    add_publication(dds_name, *type, qos), codec);
+}
+
+std::string ComponentHost::serialized_subscription(
+    const std::string& ros_topic, const std::string& dds_type, const QosProfile& qos,
+    std::function<void(std::span<const std::byte>)> callback) {
+  auto [dds_name, type] = resolve_open(ros_topic, dds_type, false);
+  const dds::CdrCodec& codec = container_.codec(*type);
+  add_subscription(dds_name, *type, qos,
+                   [&codec, cb = std::move(callback)](std::shared_ptr<const void> sample) {
+                     const std::vector<std::byte> cdr = codec.to_cdr(sample.get());
+                     cb(cdr);
+                   });
+  return type->dds_name;
+}
+
+std::string Container::Impl::declared_type(const std::string& ros_name) const {
+  for (const auto& c : graph.containers) {
+    for (const auto& instance : c.components) {
+      const RegisteredComponent* registered = ComponentRegistry::instance().find(instance.type);
+      if (registered == nullptr) continue;
+      for (const auto& port : registered->spec.publishes) {
+        if (graph::port_topic(graph, instance, port) == ros_name) return port.dds_type;
+      }
+    }
+  }
+  return {};
+}
+
+const dds::CdrCodec& Container::Impl::codec(const msg::TypeEntry& type) {
+  auto& slot = codecs[type.dds_name];
+  if (!slot) slot = std::make_unique<dds::CdrCodec>(participant, type);
+  return *slot;
 }
 
 Container::Impl::Impl(const graph::Graph& g, const graph::ContainerSpec& s)

@@ -5,6 +5,8 @@
 #include <cstring>
 #include <thread>
 
+#include "avs/runtime/sample.hpp"
+
 namespace avs::runtime::dds {
 
 namespace {
@@ -47,6 +49,25 @@ EndpointQos EndpointQos::from_dds(const dds_qos_t* qos) {
     q.liveliness_lease = finite(d);
   }
   return q;
+}
+
+EndpointQos EndpointQos::from_profile(const QosProfile& profile) {
+  EndpointQos q;
+  q.reliable = profile.reliability == Reliability::reliable;
+  q.transient_local = profile.durability == Durability::transient_local;
+  q.depth = static_cast<std::int32_t>(profile.depth);
+  q.deadline = profile.deadline;
+  return q;
+}
+
+QosProfile EndpointQos::to_profile() const {
+  QosProfile p;
+  p.reliability = reliable ? Reliability::reliable : Reliability::best_effort;
+  p.durability = transient_local ? Durability::transient_local : Durability::volatile_;
+  p.depth = static_cast<std::uint32_t>(
+      std::max<std::int32_t>(1, keep_all ? std::max(depth, 1000) : depth));
+  p.deadline = deadline;
+  return p;
 }
 
 Qos EndpointQos::to_dds() const {
@@ -227,6 +248,41 @@ std::uint32_t RawWriter::matched_readers() const {
   check_dds(dds_get_publication_matched_status(writer_.get(), &status),
             "matched status of " + topic_);
   return status.current_count;
+}
+
+CdrCodec::CdrCodec(const Participant& participant, const msg::TypeEntry& type)
+    : type_(type), sertype_(probe_sertype(participant, type)) {}
+
+CdrCodec::~CdrCodec() {
+  ddsi_sertype_unref(const_cast<ddsi_sertype*>(sertype_));
+}
+
+std::shared_ptr<void> CdrCodec::to_sample(std::span<const std::byte> cdr) const {
+  ddsrt_iovec_t iov;
+  iov.iov_base = const_cast<std::byte*>(cdr.data());
+  iov.iov_len = static_cast<ddsrt_iov_len_t>(cdr.size());
+  // Cyclone checks the bytes against the type here (lengths, bounds) and refuses bad ones.
+  ddsi_serdata* data = ddsi_serdata_from_ser_iov(sertype_, SDK_DATA, 1, &iov, cdr.size());
+  if (data == nullptr) {
+    throw Error("Cyclone refused " + std::to_string(cdr.size()) + " serialised bytes as " +
+                type_.dds_name + " (bad encapsulation header, truncated or malformed CDR)");
+  }
+  std::shared_ptr<void> sample = make_sample(type_.descriptor, type_.sample_size);
+  const bool ok = ddsi_serdata_to_sample(data, sample.get(), nullptr, nullptr);
+  ddsi_serdata_unref(data);
+  if (!ok) {
+    throw Error("cannot deserialise " + std::to_string(cdr.size()) + " bytes as " + type_.dds_name);
+  }
+  return sample;
+}
+
+std::vector<std::byte> CdrCodec::to_cdr(const void* sample) const {
+  ddsi_serdata* data = ddsi_serdata_from_sample(sertype_, SDK_DATA, sample);
+  if (data == nullptr) throw Error(std::string("cannot serialise a sample of ") + type_.dds_name);
+  std::vector<std::byte> out(ddsi_serdata_size(data));
+  ddsi_serdata_to_ser(data, 0, out.size(), out.data());
+  ddsi_serdata_unref(data);
+  return out;
 }
 
 }  // namespace avs::runtime::dds

@@ -7,10 +7,9 @@
 #include <set>
 #include <thread>
 
+#include "avs/bag/bag_source.hpp"
 #include "avs/bag/qos_yaml.hpp"
-#include "avs/introspection/type_database.hpp"
 #include "avs/mcap/reader.hpp"
-#include "avs/msg/type_registry.hpp"
 #include "avs/runtime/raw_topic.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "rosgraph_msgs.h"
@@ -22,11 +21,6 @@ namespace {
 using runtime::Error;
 namespace dds = runtime::dds;
 using SteadyClock = std::chrono::steady_clock;
-
-std::string ros_name(const std::string& name) {
-  if (name.rfind("rt/", 0) == 0) return runtime::from_dds_topic_name(name);
-  return runtime::resolve_topic_name("/", name);
-}
 
 struct ChannelPlan {
   dds::RawWriter* writer = nullptr;  // null: not played
@@ -178,27 +172,10 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
   if (!(o.rate > 0)) throw Error("avs bag play: --rate must be > 0");
   if (!(o.max_gap_s > 0)) throw Error("avs bag play: --max-gap must be > 0");
   mcap::Reader reader;
-  mcap::ReaderOptions reader_options;
-  reader_options.skip_corrupt_chunks = true;  // one bad chunk does not end the replay
   PlayResult result;
-  if (mcap::Status s = reader.open(o.file, reader_options); !s.ok()) {
-    throw Error("avs bag play: " + o.file.string() + ": " + s.to_string());
-  }
-  bool truncated = false;
-  if (mcap::Status s = reader.read_summary(); !s.ok()) {
-    mcap::ScanResult scan;
-    if (mcap::Status s2 = reader.scan(scan, true); !s2.ok()) {
-      throw Error("avs bag play: " + o.file.string() + ": " + s2.to_string());
-    }
-    truncated = scan.truncated;
-    report_skipped_chunks(o.file, scan.skipped_chunks, result);
-    std::fprintf(
-        stderr,
-        "avs bag play: %s has no usable summary (%s); playing what a scan finds%s "
-        "(`avs bag repair` fixes the file)\n",
-        o.file.string().c_str(), s.to_string().c_str(),
-        scan.truncated ? (", up to offset " + std::to_string(scan.truncated_at)).c_str() : "");
-  }
+  const OpenedBag opened = open_bag(reader, o.file, "avs bag play");
+  const bool truncated = opened.truncated;
+  report_skipped_chunks(o.file, opened.skipped_chunks, result);
   const mcap::Summary& summary = reader.summary();
   mcap::Timestamp start = 0, end = 0;
   if (summary.statistics) {
@@ -218,52 +195,28 @@ PlayResult play(const PlayOptions& o, const PlayControl& control) {
   const double duration_s = static_cast<double>(end - std::min(end, start)) * 1e-9;
 
   std::set<std::string> wanted;
-  for (const auto& t : o.topics) wanted.insert(ros_name(t));
+  for (const auto& t : o.topics) wanted.insert(ros_topic_name(t));
   std::map<std::string, std::string> remaps;
-  for (const auto& [from, to] : o.remaps) remaps[ros_name(from)] = ros_name(to);
+  for (const auto& [from, to] : o.remaps) remaps[ros_topic_name(from)] = ros_topic_name(to);
 
   dds::Participant participant(o.domain, o.partition);
   std::map<std::string, std::unique_ptr<dds::RawWriter>> writers;  // by published ROS name
   std::map<mcap::ChannelId, ChannelPlan> plans;
   std::set<std::string> read_topics;
-  for (const auto& [id, channel] : summary.channels) {
-    if (!wanted.empty() && wanted.count(channel.topic) == 0) continue;
-    auto skip = [&](const std::string& why) {
-      result.skipped.push_back(channel.topic + ": " + why);
-      std::fprintf(stderr, "avs bag play: NOT playing %s: %s\n", channel.topic.c_str(),
-                   why.c_str());
-    };
-    if (channel.message_encoding != "cdr") {
-      skip("message encoding '" + channel.message_encoding + "' (only cdr is played)");
-      continue;
-    }
-    auto schema = summary.schemas.find(channel.schema_id);
-    if (schema == summary.schemas.end()) {
-      skip("no schema (id " + std::to_string(channel.schema_id) + ")");
-      continue;
-    }
-    const std::string dds_type = introspection::dds_type_name(schema->second.name);
-    const msg::TypeEntry* type = msg::find_type(dds_type);
-    if (type == nullptr) {
-      skip("type " + schema->second.name + " is not known to this build");
-      continue;
-    }
-    std::vector<dds::EndpointQos> offered;
-    auto qos_it = channel.metadata.find("offered_qos_profiles");
-    try {
-      if (qos_it != channel.metadata.end()) offered = parse_offered_qos_yaml(qos_it->second);
-    } catch (const std::exception& e) {
-      skip(e.what());
-      continue;
-    }
+  const ChannelSelection selection = select_channels(summary, wanted);
+  for (const auto& why : selection.skipped) {
+    result.skipped.push_back(why);
+    std::fprintf(stderr, "avs bag play: NOT playing %s\n", why.c_str());
+  }
+  for (const ReplayChannel& channel : selection.channels) {
     std::string out = channel.topic;
     if (auto r = remaps.find(channel.topic); r != remaps.end()) out = r->second;
     auto& w = writers[out];
     if (!w) {
-      w = std::make_unique<dds::RawWriter>(participant, *type, runtime::to_dds_topic_name(out),
-                                           replay_qos(offered));
+      w = std::make_unique<dds::RawWriter>(
+          participant, *channel.type, runtime::to_dds_topic_name(out), replay_qos(channel.offered));
     }
-    plans[id] = {w.get(), out};
+    plans[channel.id] = {w.get(), out};
     read_topics.insert(channel.topic);
   }
   if (plans.empty()) throw Error("avs bag play: " + o.file.string() + ": no topic to play");

@@ -4,8 +4,10 @@
 // The container chooses threads; the component only sees callbacks.
 #pragma once
 
+#include <cstddef>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -46,6 +48,11 @@ struct ComponentSpec {
   /// parameters whose spec default does not reproduce the Config's default (tests walk the
   /// registry with it). Empty function: the component has no bound core Config.
   std::function<std::vector<std::string>()> default_mismatches = {};
+  /// Topics chosen at run time (bag_player, bag_recorder): the component publishes and
+  /// subscribes serialised samples of any topic with a type this build knows, named by its
+  /// ROS topic (ComponentContext::serialized_publisher / serialized_subscription) instead of
+  /// ports declared above.
+  bool open_ports = false;
 
   const ParamSpec* find_parameter(std::string_view name) const;
   const PortSpec* find_port(std::string_view name) const;
@@ -78,6 +85,17 @@ class Publisher {
   std::shared_ptr<PublisherCore> core_;
 };
 
+/// Publishing end for serialised samples (CDR, the 4-byte encapsulation header included) of
+/// a type known only at run time: the container deserialises each once for its own
+/// subscribers (who get it as if published typed) and writes it to DDS.
+class SerializedPublisher {
+ public:
+  virtual ~SerializedPublisher() = default;
+  /// Throws Error naming the topic and type when the bytes are not a sample of it.
+  virtual void publish(std::span<const std::byte> cdr) = 0;
+  virtual const std::string& topic() const = 0;
+};
+
 using TimerId = std::uint64_t;
 
 /// What a component gets from its container. Publishers and subscriptions are made for
@@ -96,6 +114,26 @@ class ComponentContext {
   /// Calls `callback` every `period` of the context's clock, on the component's thread.
   virtual TimerId create_timer(Duration period, std::function<void()> callback) = 0;
   virtual void cancel_timer(TimerId id) = 0;
+
+  /// For components with ComponentSpec::open_ports: a publisher of `ros_topic` (relative
+  /// names get the graph's namespace; the instance's remaps apply, keyed by the topic name)
+  /// with DDS type `dds_type` ("sensor_msgs::msg::dds_::Image_"). Throws Error for an unknown
+  /// type, a component without open ports, or once the container runs.
+  virtual std::shared_ptr<SerializedPublisher> serialized_publisher(const std::string& ros_topic,
+                                                                    const std::string& dds_type,
+                                                                    const QosProfile& qos) = 0;
+  /// For components with ComponentSpec::open_ports: `callback` gets every sample of
+  /// `ros_topic`, serialised, from this container's publishers and from other processes.
+  /// An empty `dds_type` means the type the graph's publishers of the topic declare.
+  /// Returns the DDS type subscribed to.
+  virtual std::string serialized_subscription(
+      const std::string& ros_topic, const std::string& dds_type, const QosProfile& qos,
+      std::function<void(std::span<const std::byte> cdr)> callback) = 0;
+
+  /// Ends the container's run, as Ctrl-C would (components are deactivated and shut down;
+  /// the exit status is 0): for a component that knows the run is complete, e.g. a bag
+  /// player at the end of its file. `why` is logged.
+  virtual void request_stop(const std::string& why) = 0;
 
   template <class T>
   T param(const std::string& name) const {

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -37,6 +38,11 @@ struct EndpointQos {
   static EndpointQos from_dds(const dds_qos_t* qos);
   /// A Cyclone QoS object with these policies.
   Qos to_dds() const;
+  /// A component port's profile (reliability, durability, depth, deadline) as an endpoint's.
+  static EndpointQos from_profile(const QosProfile& profile);
+  /// The component port profile closest to these policies (keep-all becomes a keep-last
+  /// depth of at least 1000; lifespan and liveliness have no place in a port profile).
+  QosProfile to_profile() const;
   /// "reliable, volatile, keep_last 10" (for messages).
   std::string describe() const;
 };
@@ -114,6 +120,29 @@ class RawReader {
   std::string topic_;
   Entity topic_entity_;
   Entity reader_;
+};
+
+/// Converts between serialised samples (CDR, the 4-byte encapsulation header included) and
+/// samples of the C type, for a type known only at run time: what a container does for
+/// components that deal in serialised samples (bag_player, bag_recorder). Uses the type's
+/// Cyclone sertype, so the bytes are exactly what a DDS writer of that type would send.
+class CdrCodec {
+ public:
+  CdrCodec(const Participant& participant, const msg::TypeEntry& type);
+  ~CdrCodec();
+  CdrCodec(const CdrCodec&) = delete;
+  CdrCodec& operator=(const CdrCodec&) = delete;
+
+  /// A sample (freed with everything it holds) from serialised bytes. Throws Error naming
+  /// the type when Cyclone refuses them (bad header, truncated, out-of-range lengths).
+  std::shared_ptr<void> to_sample(std::span<const std::byte> cdr) const;
+  /// The serialised bytes of a sample of the type.
+  std::vector<std::byte> to_cdr(const void* sample) const;
+  const msg::TypeEntry& type() const { return type_; }
+
+ private:
+  const msg::TypeEntry& type_;
+  const ddsi_sertype* sertype_ = nullptr;  ///< one reference, released in the destructor
 };
 
 /// A writer that publishes serialised samples (the 4-byte encapsulation header included),

@@ -1,0 +1,133 @@
+// bag_recorder: records topics into an MCAP file from inside a graph (docs/bag.md, "Replay
+// inside a graph"). It gets what the container's components publish as they publish it, so
+// nothing is lost to a loaded machine: in lockstep the graph waits for it like for any other
+// component. Log and publish times are the container's clock (sim time in a simulated graph),
+// so two runs of a lockstep graph write the same messages at the same times.
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "avs/bag/qos_yaml.hpp"
+#include "avs/introspection/type_database.hpp"
+#include "avs/mcap/writer.hpp"
+#include "avs/msg/convert.hpp"
+#include "avs/runtime/component.hpp"
+#include "avs/runtime/raw_topic.hpp"
+
+namespace avs::bag {
+namespace {
+
+using runtime::ParamSpec;
+
+class BagRecorderComponent final : public runtime::Component {
+ public:
+  static runtime::ComponentSpec spec() {
+    return {
+        .type = "bag_recorder",
+        .description = "records topics of the graph into an MCAP file (ros2 profile) on the "
+                       "container's clock, losing nothing",
+        .parameters = {ParamSpec::string("file", "", "the MCAP file to write (required)"),
+                       ParamSpec::string("topics", "",
+                                         "comma-separated topics (ROS names) to record "
+                                         "(required); each has the type the graph's "
+                                         "publishers of it declare"),
+                       ParamSpec::string("compression", "zstd", "chunk compression",
+                                         {"zstd", "lz4", "none"}),
+                       ParamSpec::integer("depth", 1000, 1, 1e6, "",
+                                          "history depth of the readers of samples from other "
+                                          "processes")},
+        .open_ports = true,
+    };
+  }
+
+  explicit BagRecorderComponent(runtime::ComponentContext& ctx)
+      : Component(ctx), file_(ctx.param<std::string>("file")) {
+    if (file_.empty()) throw runtime::Error("bag_recorder: parameter 'file' is required");
+    const std::string topics = ctx.param<std::string>("topics");
+    if (topics.empty()) throw runtime::Error("bag_recorder: parameter 'topics' is required");
+    mcap::WriterOptions options;
+    const std::string compression = ctx.param<std::string>("compression");
+    options.compression = compression == "lz4"    ? mcap::Compression::lz4
+                          : compression == "none" ? mcap::Compression::none
+                                                  : mcap::Compression::zstd;
+    check(writer_.open(file_, options), "open");
+    runtime::QosProfile qos;
+    qos.depth = static_cast<std::uint32_t>(ctx.param<int>("depth"));
+    for (const std::string& name : msg::parse_name_list(topics, 0, "topics")) {
+      Channel& channel = channels_[name];
+      channel.topic = name;
+      const std::string dds_type = ctx.serialized_subscription(
+          name, "", qos, [this, &channel](std::span<const std::byte> cdr) { write(channel, cdr); });
+      const std::string ros_type = introspection::ros_type_name(dds_type);
+      mcap::SchemaId schema = 0;
+      check(writer_.add_schema(
+                ros_type, "ros2msg",
+                introspection::ros2msg_definition(introspection::built_in_types(), dds_type),
+                schema),
+            "add schema " + ros_type);
+      const std::vector<runtime::dds::EndpointQos> offered = {
+          runtime::dds::EndpointQos::from_profile(qos)};
+      check(writer_.add_channel(name, "cdr", schema,
+                                {{"offered_qos_profiles", offered_qos_yaml(offered)},
+                                 {"topic_type_hash", ""}},
+                                channel.id),
+            "add channel " + name);
+    }
+    log().info("recording ", channels_.size(), " topic(s) into ", file_);
+  }
+
+  void on_shutdown() override { close(); }
+  ~BagRecorderComponent() override {
+    try {
+      close();
+    } catch (const std::exception& e) {
+      log().error(e.what());
+    }
+  }
+
+  std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
+    std::lock_guard lock(mutex_);
+    return {{"written", std::to_string(written_)}, {"file", file_}};
+  }
+
+ private:
+  struct Channel {
+    std::string topic;
+    mcap::ChannelId id = 0;
+  };
+
+  void write(const Channel& channel, std::span<const std::byte> cdr) {
+    const auto now =
+        static_cast<mcap::Timestamp>(std::max<std::int64_t>(0, context().now().ns));
+    check(writer_.write(channel.id, now, now, cdr), "write " + channel.topic);
+    std::lock_guard lock(mutex_);
+    ++written_;
+  }
+
+  void close() {
+    if (!writer_.is_open()) return;
+    check(writer_.close(), "close");
+    log().info("wrote ", written_, " message(s) to ", file_);
+  }
+
+  /// A write the file refused is a failure of the run (a recording must not lose silently).
+  void check(const mcap::Status& status, const std::string& what) const {
+    if (!status.ok()) {
+      throw runtime::Error("bag_recorder: " + file_ + ": " + what + ": " + status.to_string());
+    }
+  }
+
+  const std::string file_;
+  mcap::Writer writer_;
+  std::map<std::string, Channel> channels_;
+  mutable std::mutex mutex_;  ///< written_ is read by the diagnostics timer
+  std::uint64_t written_ = 0;
+};
+
+AVS_REGISTER_COMPONENT(BagRecorderComponent);
+
+}  // namespace
+}  // namespace avs::bag
