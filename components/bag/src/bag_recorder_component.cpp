@@ -90,7 +90,10 @@ class BagRecorderComponent final : public runtime::Component {
 
   std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
     std::lock_guard lock(mutex_);
-    return {{"written", std::to_string(written_)}, {"file", file_}};
+    return {{"written", std::to_string(written_)},
+            {"not_written", std::to_string(not_written_)},
+            {"file", file_},
+            {"error", failure_}};
   }
 
  private:
@@ -99,18 +102,47 @@ class BagRecorderComponent final : public runtime::Component {
     mcap::ChannelId id = 0;
   };
 
+  /// A write the file refuses (disk full, I/O error) ends the recording, loudly, and only the
+  /// recording: the rest of the graph goes on (issue 20 section 5). What was written stays
+  /// readable up to its last complete chunk (`avs bag info`, `avs bag repair`).
   void write(const Channel& channel, std::span<const std::byte> cdr) {
+    if (!failure_.empty()) {
+      std::lock_guard lock(mutex_);
+      ++not_written_;
+      return;
+    }
     const auto now =
         static_cast<mcap::Timestamp>(std::max<std::int64_t>(0, context().now().ns));
-    check(writer_.write(channel.id, now, now, cdr), "write " + channel.topic);
+    const mcap::Status status = writer_.write(channel.id, now, now, cdr);
     std::lock_guard lock(mutex_);
-    ++written_;
+    if (status.ok()) {
+      ++written_;
+      return;
+    }
+    ++not_written_;
+    failure_ = "write " + channel.topic + ": " + status.to_string();
+    log().error("bag_recorder: ", file_, ": ", failure_, ": recording STOPPED after ", written_,
+                " message(s); the rest of the graph goes on; the file is readable up to its last "
+                "complete chunk (`avs bag repair` gives it a summary)");
   }
 
   void close() {
     if (!writer_.is_open()) return;
-    check(writer_.close(), "close");
-    log().info("wrote ", written_, " message(s) to ", file_);
+    const mcap::Status status = writer_.close();
+    std::lock_guard lock(mutex_);
+    if (!failure_.empty()) {
+      // What the file holds: the chunks written before the failure; the messages of the
+      // chunk being filled then are lost with it.
+      const std::uint64_t in_file = writer_.statistics().messages_in_file;
+      log().error("bag_recorder: ", file_, ": ", in_file, " message(s) in the file, ",
+                  not_written_ + written_ - std::min(written_, in_file), " NOT written (", failure_,
+                  ")");
+    } else if (!status.ok()) {
+      log().error("bag_recorder: ", file_, ": close: ", status.to_string(), " (", written_,
+                  " message(s) written; `avs bag repair` rebuilds the summary)");
+    } else {
+      log().info("wrote ", written_, " message(s) to ", file_);
+    }
   }
 
   /// A write the file refused is a failure of the run (a recording must not lose silently).
@@ -123,8 +155,10 @@ class BagRecorderComponent final : public runtime::Component {
   const std::string file_;
   mcap::Writer writer_;
   std::map<std::string, Channel> channels_;
-  mutable std::mutex mutex_;  ///< written_ is read by the diagnostics timer
+  mutable std::mutex mutex_;  ///< the counts and failure_ are read by the diagnostics timer
   std::uint64_t written_ = 0;
+  std::uint64_t not_written_ = 0;  ///< after a failed write
+  std::string failure_;            ///< the write that failed; empty while recording
 };
 
 AVS_REGISTER_COMPONENT(BagRecorderComponent);

@@ -62,7 +62,8 @@ struct RecordedTopic {
   std::vector<dds::EndpointQos> offered;  // guarded by Impl::topics_mutex
   std::set<std::array<std::uint8_t, 16>> writers;
   std::atomic<std::uint64_t> received{0}, written{0}, bytes{0}, dds_lost{0}, dds_rejected{0},
-      queue_dropped{0};
+      queue_dropped{0}, write_failed{0};
+  std::uint64_t written_to_open_file = 0;  // writer thread only
   std::atomic<std::uint32_t> incompatible{0};
 };
 
@@ -210,9 +211,11 @@ struct Recorder::Impl {
       }
     }
     for (RecordedTopic* t : readers) {
-      const std::uint64_t now = wall_ns();
+      // The log time of each sample is read when it is taken: one clock reading for the
+      // whole batch came before samples that arrived while it was taken, and gave 47 of
+      // a sim_static recording a publish time after their log time (issue 20 section 6).
       t->reader->take(1024, [&](ddsi_serdata* data, const dds_sample_info_t& info) {
-        enqueue(*t, data, info, now);
+        enqueue(*t, data, info, wall_ns());
       });
     }
   }
@@ -265,6 +268,10 @@ struct Recorder::Impl {
     wo.chunk_size_bytes = options.chunk_size_bytes;
     check(writer.open(path, wo), "open " + path.string());
     channels.clear();
+    {
+      std::lock_guard lock(topics_mutex);
+      for (auto& [name, t] : topics) t->written_to_open_file = 0;
+    }
     file_start = 0;
     std::lock_guard lock(error_mutex);
     files.push_back(path);
@@ -346,11 +353,17 @@ struct Recorder::Impl {
           s.data = nullptr;
           queued_bytes.fetch_sub(s.size, std::memory_order_relaxed);
           if (!st.ok()) {
-            for (std::size_t j = i + 1; j < batch.size(); ++j) ddsi_serdata_unref(batch[j].data);
+            s.topic->write_failed.fetch_add(1, std::memory_order_relaxed);
+            for (std::size_t j = i + 1; j < batch.size(); ++j) {
+              batch[j].topic->write_failed.fetch_add(1, std::memory_order_relaxed);
+              queued_bytes.fetch_sub(batch[j].size, std::memory_order_relaxed);
+              ddsi_serdata_unref(batch[j].data);
+            }
             batch.clear();
             throw Error("write " + s.topic->ros_topic + ": " + st.to_string());
           }
           s.topic->written.fetch_add(1, std::memory_order_relaxed);
+          ++s.topic->written_to_open_file;
         }
         batch.clear();
         file_bytes = writer.statistics().file_bytes;
@@ -364,11 +377,21 @@ struct Recorder::Impl {
       check(writer.close(), "close " + split_path(options.output, file_index).string());
     } catch (const std::exception& e) {
       fail(e.what());
+      // The messages handed to the writer but not in a chunk it wrote (the chunk being filled
+      // when the disk filled up, queued chunks) are lost too: "written" is what the file has.
+      for (auto& [topic, channel] : channels) {
+        const std::uint64_t in_file = writer.messages_in_file(channel);
+        const std::uint64_t unwritten =
+            topic->written_to_open_file - std::min(topic->written_to_open_file, in_file);
+        topic->written.fetch_sub(unwritten);
+        topic->write_failed.fetch_add(unwritten);
+        topic->written_to_open_file -= unwritten;
+      }
       // Release what is still queued, counting it as lost, so nothing vanishes silently.
       std::unique_lock lock(queue_mutex);
       for (;;) {
         for (auto& s : queue) {
-          s.topic->queue_dropped.fetch_add(1);
+          s.topic->write_failed.fetch_add(1);
           queued_bytes.fetch_sub(s.size);
           ddsi_serdata_unref(s.data);
         }
@@ -452,6 +475,7 @@ RecorderStatus Recorder::status() const {
       c.dds_lost = t->dds_lost;
       c.dds_rejected = t->dds_rejected;
       c.queue_dropped = t->queue_dropped;
+      c.write_failed = t->write_failed;
       c.incompatible_writers = t->incompatible;
       c.skipped_because = t->skipped_because;
       s.received += c.received;
@@ -492,7 +516,11 @@ std::string format_record_report(const RecorderStatus& s) {
       out << "  LOST on " << t.topic << ": " << t.dds_lost
           << " reported lost by DDS (sample lost), " << t.dds_rejected
           << " rejected by DDS (sample rejected), " << t.queue_dropped
-          << " dropped by the recorder (queue full)\n";
+          << " dropped by the recorder (queue full)";
+      if (t.write_failed > 0) {
+        out << ", " << t.write_failed << " not written (the file failed)";
+      }
+      out << "\n";
     }
     if (t.incompatible_writers > 0) {
       out << "  NOT MATCHED on " << t.topic << ": " << t.incompatible_writers

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -63,6 +64,9 @@ struct Writer::Impl {
   std::vector<MetadataIndex> metadata_indexes;
   std::atomic<std::uint64_t> chunks_written{0};
   std::atomic<std::uint64_t> bytes_written{0};
+  std::atomic<std::uint64_t> messages_in_file{0};
+  mutable std::mutex in_file_mutex;
+  std::map<ChannelId, std::uint64_t> channel_messages_in_file;  // guarded by in_file_mutex
 
   // Background stage.
   std::thread worker;
@@ -142,6 +146,13 @@ struct Writer::Impl {
     if (Status s = file.flush(); !s.ok()) return s;
     chunk_indexes.push_back(std::move(index));
     chunks_written.fetch_add(1);
+    messages_in_file.fetch_add(job.message_count);
+    {
+      std::lock_guard lock(in_file_mutex);
+      for (const auto& [channel, entries] : job.index) {
+        channel_messages_in_file[channel] += entries.size();
+      }
+    }
     bytes_written.store(file.position());
     return {};
   }
@@ -423,7 +434,15 @@ WriterStatistics Writer::statistics() const {
   out.message_bytes = impl_->message_bytes;
   out.chunk_count = impl_->chunks_written.load();
   out.file_bytes = impl_->bytes_written.load();
+  out.messages_in_file = impl_->messages_in_file.load();
   return out;
+}
+
+std::uint64_t Writer::messages_in_file(ChannelId channel) const {
+  if (!impl_) return 0;
+  std::lock_guard lock(impl_->in_file_mutex);
+  auto it = impl_->channel_messages_in_file.find(channel);
+  return it == impl_->channel_messages_in_file.end() ? 0 : it->second;
 }
 
 }  // namespace avs::mcap

@@ -53,9 +53,12 @@ struct TopicCounters {
   std::uint64_t dds_lost = 0;
   std::uint64_t dds_rejected = 0;
   std::uint64_t queue_dropped = 0;
+  /// Received but not in the file because writing it failed (disk full): the failing
+  /// message, those queued behind it and those of the chunk that was being filled.
+  std::uint64_t write_failed = 0;
   std::uint32_t incompatible_writers = 0;  ///< writers not matched (QoS): not recorded at all
   std::string skipped_because;             ///< non-empty: the topic is not recorded
-  std::uint64_t lost() const { return dds_lost + dds_rejected + queue_dropped; }
+  std::uint64_t lost() const { return dds_lost + dds_rejected + queue_dropped + write_failed; }
 };
 
 struct RecorderStatus {

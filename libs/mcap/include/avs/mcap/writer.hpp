@@ -40,6 +40,9 @@ struct WriterStatistics {
   std::uint64_t message_bytes = 0;  ///< payload bytes handed to write()
   std::uint64_t chunk_count = 0;    ///< chunks written to the file so far
   std::uint64_t file_bytes = 0;     ///< bytes written to the file so far
+  /// Messages of the chunks written to the file so far: after a failed write (disk full)
+  /// the ones in the file; the others (the chunk being filled, queued chunks) are lost.
+  std::uint64_t messages_in_file = 0;
 };
 
 class Writer {
@@ -74,6 +77,8 @@ class Writer {
   Status close();
 
   WriterStatistics statistics() const;
+  /// WriterStatistics::messages_in_file of one channel.
+  std::uint64_t messages_in_file(ChannelId channel) const;
 
  private:
   struct Impl;
