@@ -283,5 +283,48 @@ TEST(RollingDecoder, RejectsFramesThatDoNotFit) {
       std::invalid_argument);
 }
 
+// Issue 20 section 5: the pattern source restarts (its process killed and started again) and
+// counts its cycles from 0 again. Its frames are not "late": the decoder starts over with them
+// and gives the new stream's depth after one whole cycle, instead of discarding every frame
+// until the new counter passes the old one.
+TEST(RollingDecoder, ASourceThatStartsAgainIsDecodedAfterOneCycle) {
+  const DecoderConfig config;
+  const auto a = render_plane(config.geometry, scene_config(51, 1.0));
+  const auto b = render_plane(config.geometry, scene_config(52, 0.8));
+  RollingDecoder decoder(config);
+  for (int cycle = 100; cycle < 103; ++cycle) {
+    for (int k = 0; k < kBits; ++k) {
+      decoder.push_frame(a.frame(k, Polarity::kPositive, cycle));
+      decoder.push_frame(a.frame(k, Polarity::kNegative, cycle));
+    }
+  }
+  EXPECT_EQ(decoder.stats().source_restarts, 0);
+  // A frame one cycle late is late, not a restart.
+  decoder.push_frame(a.frame(0, Polarity::kPositive, 101));
+  EXPECT_EQ(decoder.stats().out_of_order_frames, 1);
+  EXPECT_EQ(decoder.stats().source_restarts, 0);
+  DecodeResult result;
+  for (int k = 0; k < kBits; ++k) {
+    decoder.push_frame(b.frame(k, Polarity::kPositive, 0));
+    result = decoder.push_frame(b.frame(k, Polarity::kNegative, 0));
+    EXPECT_TRUE(result.depth_updated) << "bit " << k;
+    if (k < kBits - 1) {
+      EXPECT_EQ(count_valid(result.depth_m), 0) << "old bits mixed into the new stream, bit " << k;
+    }
+  }
+  EXPECT_EQ(decoder.stats().source_restarts, 1);
+  EXPECT_EQ(decoder.stats().out_of_order_frames, 1);
+  EXPECT_EQ(decoder.stats().frames_received, 3 * 2 * kBits + 1 + 2 * kBits);
+  // The new stream's depth (0.8 m), not the old one's (1 m).
+  int valid = 0, near_08 = 0;
+  for (float z : result.depth_m) {
+    if (std::isnan(z)) continue;
+    ++valid;
+    near_08 += std::abs(z - 0.8F) < 0.01F;
+  }
+  EXPECT_GT(valid, 200000);
+  EXPECT_GT(near_08, valid * 99 / 100);
+}
+
 }  // namespace
 }  // namespace avs::decode

@@ -1,5 +1,6 @@
 // avs bench [NAME [--json] [ARGS...]]: runs a registered benchmark and prints ours beside
 // the peer measured in the same run, or one JSON object with unit-carrying keys.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 
@@ -39,7 +40,12 @@ void print_json(const bench::Report& report) {
   std::printf("{");
   bool first = true;
   for (const auto& [key, value] : report.json) {
-    std::printf("%s\"%s\": %.6g", first ? "" : ", ", key.c_str(), value);
+    // JSON has no NaN or infinity: a figure that could not be measured is null.
+    if (std::isfinite(value)) {
+      std::printf("%s\"%s\": %.6g", first ? "" : ", ", key.c_str(), value);
+    } else {
+      std::printf("%s\"%s\": null", first ? "" : ", ", key.c_str());
+    }
     first = false;
   }
   std::printf("}\n");

@@ -8,8 +8,6 @@
 //   shm            the same through iceoryx shared memory (RouDi started by the bench)
 // The Cyclone configuration is the one a deployment generates for one host on `lo` (what
 // `avs launch` gives its containers), as in `avs bench transport`.
-#include <fcntl.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -35,10 +33,9 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
 #include "avs/runtime/error.hpp"
+#include "avs_child.hpp"
 #include "dds_environment.hpp"
 #include "graph_loading.hpp"
-
-extern char** environ;
 
 namespace avs::cli {
 namespace {
@@ -285,64 +282,6 @@ struct PlacementResult {
   }
 };
 
-std::string loadavg() {
-  std::ifstream in("/proc/loadavg");
-  std::string a, b, c;
-  in >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
-
-/// The source as `avs container FILE --name source` with CYCLONEDDS_URI = xml; stderr to `log`.
-class SourceProcess {
- public:
-  SourceProcess(const fs::path& graph, const std::string& xml, int domain, const fs::path& log) {
-    std::vector<std::string> env;
-    for (char** e = environ; *e != nullptr; ++e) {
-      const std::string_view s(*e);
-      if (s.rfind("CYCLONEDDS_URI=", 0) != 0 && s.rfind("AVS_DOMAIN_ID=", 0) != 0) {
-        env.emplace_back(s);
-      }
-    }
-    env.push_back("CYCLONEDDS_URI=" + xml);
-    env.push_back("AVS_DOMAIN_ID=" + std::to_string(domain));
-    std::vector<std::string> args{"avs", "container", graph.string(), "--name", "source"};
-    std::vector<char*> argv, envp;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    for (auto& e : env) envp.push_back(e.data());
-    envp.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_adddup2(&actions, 1, 2);
-    const int rc =
-        posix_spawn(&pid_, "/proc/self/exe", &actions, nullptr, argv.data(), envp.data());
-    posix_spawn_file_actions_destroy(&actions);
-    if (rc != 0) throw runtime::Error("avs bench pipeline: cannot start the source process");
-  }
-  SourceProcess(const SourceProcess&) = delete;
-  SourceProcess& operator=(const SourceProcess&) = delete;
-  ~SourceProcess() {
-    terminate();
-    wait();
-  }
-  void terminate() {
-    if (pid_ > 0) kill(pid_, SIGTERM);
-  }
-  /// Waits for the exit (status in `status`).
-  void wait(int* status = nullptr) {
-    if (pid_ <= 0) return;
-    int st = 0;
-    while (waitpid(pid_, &st, 0) < 0 && errno == EINTR) {
-    }
-    pid_ = -1;
-    if (status != nullptr) *status = st;
-  }
-
- private:
-  pid_t pid_ = -1;
-};
-
 PlacementResult run_placement(const Options& o, const std::string& placement, int domain,
                               const std::string& xml) {
   PlacementResult r;
@@ -374,7 +313,9 @@ PlacementResult run_placement(const Options& o, const std::string& placement, in
   } else {
     int child_status = 0;
     {
-      SourceProcess source(graph_file, xml, domain, dir / (placement + "_source.log"));
+      // The source as `avs container FILE --name source`; stderr to its log.
+      AvsChild source({"container", graph_file.string(), "--name", "source"}, xml, domain,
+                      dir / (placement + "_source.log"), "avs bench pipeline");
       // The source waits for decode's reader, then for its start delay; it replays for
       // o.seconds from its first frame. Then it is stopped (SIGTERM: it writes its report).
       const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
@@ -393,7 +334,7 @@ PlacementResult run_placement(const Options& o, const std::string& placement, in
       }
       std::this_thread::sleep_for(std::chrono::duration<double>(o.seconds + 1.0));
       source.terminate();
-      source.wait(&child_status);
+      child_status = source.wait();
     }
     std::this_thread::sleep_for(std::chrono::seconds(1));
     container.stop();
@@ -443,7 +384,7 @@ PlacementResult run_placement(const Options& o, const std::string& placement, in
     r.pose_rate_hz = static_cast<double>(p.poses - 1) /
                      (1e-9 * static_cast<double>(p.last_pose_ns - p.first_pose_ns));
   }
-  r.loadavg = loadavg();
+  r.loadavg = bench::load_average();
   return r;
 }
 
@@ -573,7 +514,7 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
 
   bench::Report report;
   std::ostringstream title;
-  const std::string load_before = loadavg();
+  const std::string load_before = bench::load_average();
   title << "avs bench pipeline: /camera/pattern at 1000 fps of wall-clock time for " << o.seconds
         << " s per placement -> decode -> tracking -> matching (ken, manipulator trajectory); "
         << "load average before: " << load_before << " (2-core machine shared with builds)";
@@ -608,7 +549,7 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
   report.json["seconds_per_placement"] = o.seconds;
   report.json["recorded_frames"] = o.recorded_frames;
   report.json["load_average_1min_before"] = std::atof(load_before.c_str());
-  report.json["load_average_1min_after"] = std::atof(loadavg().c_str());
+  report.json["load_average_1min_after"] = std::atof(bench::load_average().c_str());
   return report;
 }
 

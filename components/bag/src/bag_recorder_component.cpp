@@ -5,6 +5,7 @@
 // so two runs of a lockstep graph write the same messages at the same times.
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 #include <mutex>
 #include <string>
@@ -27,8 +28,9 @@ class BagRecorderComponent final : public runtime::Component {
   static runtime::ComponentSpec spec() {
     return {
         .type = "bag_recorder",
-        .description = "records topics of the graph into an MCAP file (ros2 profile) on the "
-                       "container's clock, losing nothing",
+        .description =
+            "records topics of the graph into an MCAP file (ros2 profile) on the "
+            "container's clock, losing nothing",
         .parameters = {ParamSpec::string("file", "", "the MCAP file to write (required)"),
                        ParamSpec::string("topics", "",
                                          "comma-separated topics (ROS names) to record "
@@ -38,14 +40,28 @@ class BagRecorderComponent final : public runtime::Component {
                                          {"zstd", "lz4", "none"}),
                        ParamSpec::integer("depth", 1000, 1, 1e6, "",
                                           "history depth of the readers of samples from other "
-                                          "processes")},
+                                          "processes"),
+                       ParamSpec::string("if_exists", "keep",
+                                         "when the file exists: keep it and record into the "
+                                         "next free <stem>.<N>.mcap (a restarted recorder "
+                                         "loses nothing), overwrite it, or fail",
+                                         {"keep", "overwrite", "fail"}),
+                       ParamSpec::real("max_chunk_age_s", 1.0, 0.0, 3600.0, "s",
+                                       "a chunk is written once its first message is this old "
+                                       "(container clock): what a killed recorder can lose; "
+                                       "0: chunks close by size only")},
         .open_ports = true,
     };
   }
 
   explicit BagRecorderComponent(runtime::ComponentContext& ctx)
-      : Component(ctx), file_(ctx.param<std::string>("file")) {
-    if (file_.empty()) throw runtime::Error("bag_recorder: parameter 'file' is required");
+      : Component(ctx),
+        file_(file_to_write(ctx.param<std::string>("file"), ctx.param<std::string>("if_exists"))),
+        max_chunk_age_ns_(static_cast<std::int64_t>(ctx.param<double>("max_chunk_age_s") * 1e9)) {
+    if (file_ != ctx.param<std::string>("file")) {
+      log().warn("bag_recorder: ", ctx.param<std::string>("file"),
+                 " exists and is kept (if_exists: keep); recording into ", file_);
+    }
     const std::string topics = ctx.param<std::string>("topics");
     if (topics.empty()) throw runtime::Error("bag_recorder: parameter 'topics' is required");
     mcap::WriterOptions options;
@@ -113,7 +129,16 @@ class BagRecorderComponent final : public runtime::Component {
     }
     const auto now =
         static_cast<mcap::Timestamp>(std::max<std::int64_t>(0, context().now().ns));
-    const mcap::Status status = writer_.write(channel.id, now, now, cdr);
+    mcap::Status status = writer_.write(channel.id, now, now, cdr);
+    if (status.ok() && max_chunk_age_ns_ > 0) {
+      // Bounds what a SIGKILL can take: only the chunk being filled is lost with the process.
+      if (chunk_start_ns_ < 0) {
+        chunk_start_ns_ = static_cast<std::int64_t>(now);
+      } else if (static_cast<std::int64_t>(now) - chunk_start_ns_ >= max_chunk_age_ns_) {
+        status = writer_.flush_chunk();
+        chunk_start_ns_ = -1;
+      }
+    }
     std::lock_guard lock(mutex_);
     if (status.ok()) {
       ++written_;
@@ -145,6 +170,27 @@ class BagRecorderComponent final : public runtime::Component {
     }
   }
 
+  /// The file to record into: `file`, or with if_exists "keep" and `file` present the first
+  /// free <stem>.<N><extension> (N from 1), so a respawned recorder keeps the killed run's file.
+  static std::string file_to_write(const std::string& file, const std::string& if_exists) {
+    if (file.empty()) throw runtime::Error("bag_recorder: parameter 'file' is required");
+    namespace fs = std::filesystem;
+    const fs::path path(file);
+    std::error_code ec;
+    if (if_exists == "overwrite" || !fs::exists(path, ec)) return file;
+    if (if_exists == "fail") {
+      throw runtime::Error("bag_recorder: " + file + " exists (if_exists: fail)");
+    }
+    for (int n = 1; n < 100000; ++n) {
+      fs::path next = path;
+      next.replace_filename(path.stem().string() + "." + std::to_string(n) +
+                            path.extension().string());
+      if (!fs::exists(next, ec)) return next.string();
+    }
+    throw runtime::Error("bag_recorder: " + file + ": no free name <stem>.<N>" +
+                         path.extension().string() + " up to N = 99999");
+  }
+
   /// A write the file refused is a failure of the run (a recording must not lose silently).
   void check(const mcap::Status& status, const std::string& what) const {
     if (!status.ok()) {
@@ -153,6 +199,8 @@ class BagRecorderComponent final : public runtime::Component {
   }
 
   const std::string file_;
+  const std::int64_t max_chunk_age_ns_;
+  std::int64_t chunk_start_ns_ = -1;  ///< log time of the open chunk's first message; -1: none
   mcap::Writer writer_;
   std::map<std::string, Channel> channels_;
   mutable std::mutex mutex_;  ///< the counts and failure_ are read by the diagnostics timer

@@ -174,7 +174,7 @@ class DecodeComponent final : public runtime::Component {
     const DecoderStats s = decoder_.stats();
     log().info(s.frames_received, " frames, ", s.pairs_decoded, " pairs, ", published_,
                " depth maps; dropped ", s.dropped_frames, ", out of order ", s.out_of_order_frames,
-               ", incomplete pairs ", s.incomplete_pairs);
+               ", incomplete pairs ", s.incomplete_pairs, ", source restarts ", s.source_restarts);
   }
 
   std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
@@ -186,6 +186,7 @@ class DecodeComponent final : public runtime::Component {
             {"dropped_frames", std::to_string(s.dropped_frames)},
             {"out_of_order_frames", std::to_string(s.out_of_order_frames)},
             {"incomplete_pairs", std::to_string(s.incomplete_pairs)},
+            {"source_restarts", std::to_string(s.source_restarts)},
             {"processing_ms_mean",
              std::to_string(published_ > 0 ? total_ms_ / static_cast<double>(published_) : 0.0)},
             {"processing_ms_max", std::to_string(max_ms_)},
@@ -342,6 +343,12 @@ class DecodeComponent final : public runtime::Component {
   /// Logs the first few losses (and every 1000th after); the counts go to /diagnostics.
   void report_losses(const DecoderStats& before, const DecoderStats& after,
                      const msgs::avs_msgs::PatternFrame& m) {
+    if (after.source_restarts != before.source_restarts) {
+      log().warn("frame cycle ", m.cycle, " bit ", int{m.bit_index},
+                 ": more than two cycles behind the newest frame, so the source started again "
+                 "(restart ",
+                 after.source_restarts, "); decoding starts over with it");
+    }
     const std::int64_t events = (after.dropped_frames - before.dropped_frames) +
                                 (after.out_of_order_frames - before.out_of_order_frames);
     if (events == 0) return;

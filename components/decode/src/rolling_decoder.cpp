@@ -173,6 +173,17 @@ void RollingDecoder::reset() {
 }
 
 bool RollingDecoder::accept_sequence(std::int64_t sequence) {
+  // A late frame is a few frames behind; one more than two whole cycles behind comes from a
+  // source that started counting again (its process restarted, issue 20 section 5). Without
+  // this, every frame of the new stream would be "out of order" until it overtook the old
+  // counter: no depth for as long as the old stream had run. The old bits describe the old
+  // stream: start over with the new one.
+  if (newest_sequence_ >= 0 && sequence < newest_sequence_ - 4 * bit_count_) {
+    DecoderStats kept = stats_;
+    reset();
+    stats_ = kept;
+    ++stats_.source_restarts;
+  }
   if (sequence <= newest_sequence_) {
     ++stats_.out_of_order_frames;  // late or repeated: its slot has passed, never reassigned
     return false;

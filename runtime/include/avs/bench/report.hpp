@@ -4,6 +4,7 @@
 // with AVS_REGISTER_BENCH in a component library.
 #pragma once
 
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -85,6 +86,15 @@ class Options {
   std::map<std::string, bool> used_;
   std::vector<std::string> asked_;  ///< every key asked for, in order (for finish()'s message)
 };
+
+/// The 1-, 5- and 15-minute load averages as /proc/loadavg gives them ("0.52 0.61 0.70"),
+/// printed beside every wall-clock figure; empty when unreadable.
+inline std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string a, b, c;
+  if (!(in >> a >> b >> c)) return "";
+  return a + " " + b + " " + c;
+}
 
 inline bool register_bench(std::string name, std::string description, BenchFunction run) {
   bench_registry().push_back({std::move(name), std::move(description), std::move(run)});

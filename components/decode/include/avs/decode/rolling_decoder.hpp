@@ -74,6 +74,9 @@ struct DecoderStats {
   std::int64_t out_of_order_frames =
       0;  ///< frames older than (or equal to) the newest seen; discarded
   std::int64_t incomplete_pairs = 0;  ///< negatives whose positive never arrived
+  /// Frames more than two whole cycles behind the newest: the source started again (its
+  /// counters from 0, as a restarted camera or simulator does); the decoder started over.
+  std::int64_t source_restarts = 0;
 };
 
 struct DecodeResult {
