@@ -36,4 +36,8 @@ class AvsChild {
   int status_ = 0;
 };
 
+/// The pid of `launcher`'s child running container `name` (`avs launch` runs each as
+/// `avs container FILE --name NAME`), or -1 when there is none (dead, or being restarted).
+pid_t container_pid(pid_t launcher, const std::string& name);
+
 }  // namespace avs::cli

@@ -185,34 +185,6 @@ Options parse_options(const std::vector<std::string>& raw) {
 
 // ---- the processes ------------------------------------------------------------------------------
 
-/// The pid of the launcher's child running container `name` (`avs container FILE --name
-/// NAME`), or -1.
-pid_t container_pid(pid_t launcher, const std::string& name) {
-  std::error_code ec;
-  for (const auto& entry : fs::directory_iterator("/proc", ec)) {
-    const std::string pid_text = entry.path().filename().string();
-    if (pid_text.find_first_not_of("0123456789") != std::string::npos) continue;
-    std::ifstream stat(entry.path() / "stat");
-    std::string line;
-    if (!std::getline(stat, line)) continue;
-    // "pid (comm) state ppid ...": the command may hold spaces and parentheses.
-    const auto close = line.rfind(')');
-    if (close == std::string::npos) continue;
-    std::istringstream rest(line.substr(close + 1));
-    std::string state;
-    pid_t ppid = 0;
-    rest >> state >> ppid;
-    if (ppid != launcher || state == "Z") continue;
-    std::ifstream cmdline(entry.path() / "cmdline");
-    std::vector<std::string> words;
-    for (std::string w; std::getline(cmdline, w, '\0');) words.push_back(w);
-    for (std::size_t i = 0; i + 1 < words.size(); ++i) {
-      if (words[i] == "--name" && words[i + 1] == name) return std::atoi(pid_text.c_str());
-    }
-  }
-  return -1;
-}
-
 // ---- one kill -------------------------------------------------------------------------------
 
 struct KillResult {
