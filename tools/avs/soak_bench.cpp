@@ -362,10 +362,10 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
         << ", graph 1 nohead dt 2\n"
         << "names = '" << names << "'\n"
         << "plot for [c in names] 'samples.csv' every ::1 using 1:(strcol(2) eq c ? $3 / 1024 : "
-           "1/0) with lines title c\n"
+           "1/0) with points pt 7 ps 0.4 title c\n"
         << "set title 'Open file descriptors per container'\nset ylabel 'descriptors'\n"
         << "plot for [c in names] 'samples.csv' every ::1 using 1:(strcol(2) eq c ? $4 : 1/0) "
-           "with lines title c\nunset multiplot\n";
+           "with points pt 7 ps 0.4 title c\nunset multiplot\n";
     try {
       (void)report::run_gnuplot(dir, "soak.gp");
       report.notes.push_back("figure: " + (dir / "soak.png").string());
