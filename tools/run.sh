@@ -2,6 +2,8 @@
 # The two set-up commands of the README:
 #   bash tools/run.sh demo   installs what is missing, builds, runs the main job
 #   bash tools/run.sh test   installs what is missing, builds, runs every test (CTest)
+#   bash tools/run.sh test --sanitize   the same in an ASan + UBSan build (build-sanitize;
+#                            docs/reliability.md "Sanitizers"); extra words go to ctest
 # Both are idempotent and quick when nothing changed. Run as root on Debian 12 (or with sudo).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,6 +36,7 @@ BUILD_DIR=${AVS_BUILD_DIR:-build}
 # The demo builds only the `avs` program, without tests and benchmarks, in its own folder, so
 # that a fresh machine gets to the demo without installing PCL and OpenCV.
 DEMO_BUILD_DIR=${AVS_DEMO_BUILD_DIR:-build-demo}
+SANITIZE_BUILD_DIR=${AVS_SANITIZE_BUILD_DIR:-build-sanitize}
 JOBS=${AVS_JOBS:-$(nproc)}
 
 install_missing() {
@@ -75,12 +78,26 @@ case "${1:-}" in
     # Debian's nodejs comes without npm (a separate package); a nodejs that bundles npm (and
     # conflicts with Debian's) needs none. The MCAP reader and `avs view` checks need npm.
     command -v npm >/dev/null || install_missing npm
+    shift
+    if [ "${1:-}" = "--sanitize" ]; then
+      shift
+      # Every target with ASan + UBSan (cmake/AvsSanitize.cmake); a finding fails its test.
+      # Suppressions, each with its reason, are in tests/sanitizers/.
+      supp=$PWD/tests/sanitizers
+      export ASAN_OPTIONS="detect_leaks=1:halt_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
+      export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
+      export UBSAN_OPTIONS="suppressions=$supp/ubsan.supp:print_stacktrace=1:halt_on_error=1"
+      build "$SANITIZE_BUILD_DIR" -DAVS_SANITIZE=address,undefined -DAVS_BUILD_BENCHMARKS=OFF
+      cd "$SANITIZE_BUILD_DIR"
+      # Instrumented code runs 2-4 times slower: longer timeouts, same tests.
+      exec ctest --output-on-failure -j "$JOBS" --timeout 1800 "$@"
+    fi
     build "$BUILD_DIR"
     cd "$BUILD_DIR"
-    exec ctest --output-on-failure -j "$JOBS" --timeout 600
+    exec ctest --output-on-failure -j "$JOBS" --timeout 600 "$@"
     ;;
   *)
-    echo "usage: bash tools/run.sh demo|test" >&2
+    echo "usage: bash tools/run.sh demo [avs demo options] | test [--sanitize] [ctest options]" >&2
     exit 2
     ;;
 esac
