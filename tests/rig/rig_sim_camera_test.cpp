@@ -136,7 +136,12 @@ TEST(RigSimCamera, GraphKeepsRunningThroughAProjectorOutageAndMatchingFindsTheOb
   // The graph kept running while it was away, and after.
   EXPECT_GT(c->depth_maps_while_projector_away.load(), 0);
   EXPECT_GT(c->depth_maps_after_reconnect.load(), 0);
-  EXPECT_EQ(std::to_string(c->depth_maps.load()), decode.at("depth_published"));
+  // Every depth map decode published reached the checker, but for one published as the
+  // container stopped (its lanes stop on the wall clock, each on its own thread; it once came
+  // 1157 against 1158 in CI).
+  const long long published = std::stoll(decode.at("depth_published"));
+  EXPECT_LE(c->depth_maps.load(), published);
+  EXPECT_GE(c->depth_maps.load(), published - 1);
   EXPECT_GT(c->joint_states.load(), 0);
   // static_ken.yaml puts the ken model at (1.0, 0, 0) m in the world, the head at rest.
   ASSERT_GT(c->world_poses.load(), 0);
