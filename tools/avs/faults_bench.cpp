@@ -30,9 +30,10 @@
 #include "avs/runtime/container.hpp"
 #include "avs/runtime/error.hpp"
 #include "avs/runtime/time.hpp"
+#include "avs/servo/safety.hpp"
 #include "avs_child.hpp"
 #include "dds_environment.hpp"
-#include "graph_loading.hpp"
+#include "probe_container.hpp"
 
 namespace avs::cli {
 namespace {
@@ -204,7 +205,8 @@ struct KillResult {
   double servo_gap_s = NAN;              ///< longest gap in torque commands (matcher killed)
 };
 
-constexpr double kCommandTimeoutS = 0.02;  // servo_drive's command_timeout_s default
+// servo_drive's command_timeout_s default (the graph leaves it).
+const double kCommandTimeoutS = servo::CommandFreshness{}.timeout_s;
 
 double median_period_ms(const std::vector<Seen>& v, std::int64_t before_ns, std::size_t n) {
   std::vector<double> periods;
@@ -361,12 +363,6 @@ bool wait_for(const std::function<bool()>& done, double timeout_s) {
   return true;
 }
 
-std::string probe_graph() {
-  return "# Written by avs bench faults (tools/avs/faults_bench.cpp).\n"
-         "clock: {source: wall}\ncontainers:\n"
-         "  - name: probe\n    components:\n      - {type: bench_faults_probe, name: probe}\n";
-}
-
 bench::Report faults_bench(const std::vector<std::string>& args) {
   const Options o = parse_options(args);
   const fs::path dir = fs::absolute(o.dir);
@@ -389,29 +385,9 @@ bench::Report faults_bench(const std::vector<std::string>& args) {
   report.title = title.str();
 
   // The probe first: it sees the first samples of every stage.
-  const fs::path probe_file = dir / "probe_graph.yaml";
-  std::ofstream(probe_file) << probe_graph();
-  setenv("CYCLONEDDS_URI", xml.c_str(), 1);
-  auto probe_graph_loaded = load_or_report(probe_file.string(), {});
-  if (!probe_graph_loaded) throw runtime::Error("avs bench faults: the probe graph did not load");
-  probe_graph_loaded->domain_id = domain;
-  runtime::Container container(*probe_graph_loaded, probe_graph_loaded->containers.at(0));
-  std::thread runner([&] { (void)container.run(); });
-  const auto* probe = [&]() -> const FaultProbe* {
-    const FaultProbe* p = nullptr;
-    (void)wait_for(
-        [&] { return (p = dynamic_cast<const FaultProbe*>(container.find_component("probe"))); },
-        30);
-    return p;
-  }();
-  const auto stop_probe = [&] {
-    container.stop();
-    if (runner.joinable()) runner.join();
-  };
-  if (probe == nullptr) {
-    stop_probe();
-    throw runtime::Error("avs bench faults: the probe did not start");
-  }
+  ProbeContainer<FaultProbe> probe_container(dir, "bench_faults_probe", xml, domain,
+                                             "avs bench faults");
+  const FaultProbe* probe = &probe_container.probe();
 
   const fs::path bag = dir / "loop.mcap";
   const fs::path launch_log = dir / "launch.log";
@@ -425,7 +401,6 @@ bench::Report faults_bench(const std::vector<std::string>& args) {
                  launch_log.c_str());
     if (!wait_for([&] { return !probe->data().poses.empty() || !launcher.running(); }, 180) ||
         !launcher.running()) {
-      stop_probe();
       throw runtime::Error("avs bench faults: no pose within 180 s of the launch; see " +
                            launch_log.string());
     }
@@ -443,7 +418,6 @@ bench::Report faults_bench(const std::vector<std::string>& args) {
         if (v->empty() || v->back().arrival_ns < recent) missing += std::string(" ") + topic;
       }
       if (!missing.empty()) {
-        stop_probe();
         throw runtime::Error("avs bench faults: the loop does not run before the first kill (no" +
                              missing + " in the last second); see " + launch_log.string());
       }
@@ -523,7 +497,7 @@ bench::Report faults_bench(const std::vector<std::string>& args) {
       report.notes.push_back("avs launch ended abnormally (status " + std::to_string(status) + ")");
     }
   }
-  stop_probe();
+  probe_container.stop();
 
   // ---- the table ----
   double max_recovery = 0;

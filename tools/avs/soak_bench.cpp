@@ -28,6 +28,7 @@
 #include "avs_child.hpp"
 #include "dds_environment.hpp"
 #include "graph_loading.hpp"
+#include "probe_container.hpp"
 
 namespace avs::cli {
 namespace {
@@ -203,29 +204,8 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
         << " s of warm-up; load average before: " << load_before;
   report.title = title.str();
 
-  const fs::path probe_file = dir / "probe_graph.yaml";
-  std::ofstream(probe_file) << "# Written by avs bench soak (tools/avs/soak_bench.cpp).\n"
-                               "clock: {source: wall}\ncontainers:\n  - name: probe\n"
-                               "    components:\n      - {type: bench_soak_probe, name: probe}\n";
-  setenv("CYCLONEDDS_URI", xml.c_str(), 1);
-  auto probe_graph = load_or_report(probe_file.string(), {});
-  if (!probe_graph) throw runtime::Error("avs bench soak: the probe graph did not load");
-  probe_graph->domain_id = domain;
-  runtime::Container container(*probe_graph, probe_graph->containers.at(0));
-  std::thread runner([&] { (void)container.run(); });
-  const SoakProbe* probe = nullptr;
-  for (int i = 0; i < 3000 && probe == nullptr; ++i) {
-    probe = dynamic_cast<const SoakProbe*>(container.find_component("probe"));
-    if (probe == nullptr) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  const auto stop_probe = [&] {
-    container.stop();
-    if (runner.joinable()) runner.join();
-  };
-  if (probe == nullptr) {
-    stop_probe();
-    throw runtime::Error("avs bench soak: the probe did not start");
-  }
+  ProbeContainer<SoakProbe> probe_container(dir, "bench_soak_probe", xml, domain, "avs bench soak");
+  const SoakProbe* probe = &probe_container.probe();
 
   std::map<std::string, Series> series;
   std::map<std::string, double> counters_after_warm_up, counters_end;
@@ -251,7 +231,6 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (t_s > run_s) break;
       if (!launcher.running()) {
-        stop_probe();
         throw runtime::Error("avs bench soak: avs launch ended after " + std::to_string(t_s) +
                              " s; see " + launch_log.string());
       }
@@ -291,7 +270,7 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
     launcher.terminate();
     (void)launcher.wait();
   }
-  stop_probe();
+  probe_container.stop();
   csv.close();
 
   double rss_total_slope = 0;
