@@ -318,24 +318,145 @@ TEST(McapMalformed, RepairInPlaceKeepsEveryIntactChunkAndNeverWritesOverItsInput
   for (const auto& p : {input, output, report.written_to}) std::filesystem::remove(p);
 }
 
+/// Reads `bytes` as `bag play` does (corrupt chunks skipped, truncation tolerated), through
+/// its summary or, `with_summary` false, by a linear scan of it cut after its last chunk.
+Status read_skipping(std::vector<std::byte> bytes, bool with_summary,
+                     const std::vector<ChunkIndex>& chunks, std::vector<ReadMessage>& got,
+                     ReadReport& report) {
+  if (!with_summary) bytes.resize(chunks.back().chunk_start_offset + chunks.back().chunk_length);
+  ReaderOptions skipping;
+  skipping.skip_corrupt_chunks = true;
+  Reader reader;
+  if (Status s = reader.open_memory(bytes, skipping); !s.ok()) return s;
+  ReadOptions options;
+  options.allow_truncated = true;
+  return read_all(reader, got, options, &report);
+}
+
+// Issue 20 section 2: a chunk's length field is one u64 among its bytes. A flipped bit there
+// ended repair's scan at that chunk (every chunk after it lost) or, with a length covering the
+// next chunk, hid that chunk inside it. The chunk's own fields frame it as well.
+TEST(McapMalformed, RepairKeepsEveryChunkWhenAChunksLengthFieldIsCorrupt) {
+  std::vector<ChunkIndex> chunks;
+  const auto bytes = nine_chunk_bag(chunks, 9);  // nothing flipped
+  ASSERT_EQ(chunks.size(), 9u);
+  const ChunkIndex& victim = chunks[4];
+  const std::uint64_t declared = victim.chunk_length - kRecordPrefixSize;
+  const struct {
+    const char* name;
+    std::uint64_t length;
+  } cases[] = {
+      {"past the end of the file", std::uint64_t{1} << 40},
+      {"shorter than the chunk", declared - 100},
+      {"covering the next chunk",
+       chunks[6].chunk_start_offset - victim.chunk_start_offset - kRecordPrefixSize},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    auto corrupt = bytes;
+    detail::write_u64_at(corrupt.data() + victim.chunk_start_offset + 1, c.length);
+    // A strict reader's linear scan refuses it (or, for the covering length, misses a chunk).
+    {
+      auto no_summary = corrupt;
+      no_summary.resize(chunks.back().chunk_start_offset + chunks.back().chunk_length);
+      std::vector<ReadMessage> strict;
+      ReadOptions options;
+      options.allow_truncated = true;
+      const Status s = read_memory(no_summary, strict, options);
+      EXPECT_TRUE(!s.ok() || strict.size() < golden_messages().size());
+    }
+    const auto input = temp_path("length_field.mcap");
+    const auto output = temp_path("length_field_out.mcap");
+    write_bytes(input, corrupt);
+    RepairReport report;
+    const Status repaired = repair_file(input, output, report);
+    ASSERT_TRUE(repaired.ok()) << repaired.to_string();
+    EXPECT_TRUE(report.skipped_chunks.empty())
+        << report.skipped_chunks.front().offset << ": " << report.skipped_chunks.front().problem;
+    EXPECT_EQ(report.chunk_lengths_corrected, 1u);
+    EXPECT_EQ(report.chunks_kept, 9u);
+    EXPECT_EQ(report.messages_kept, golden_messages().size());
+    Reader reader;
+    ASSERT_TRUE(reader.open(output).ok());
+    ASSERT_TRUE(reader.read_summary().ok());
+    std::vector<ReadMessage> got;
+    ASSERT_TRUE(read_all(reader, got).ok());
+    EXPECT_EQ(got.size(), golden_messages().size());
+
+    // A skipping reader (bag play) reads it whole, through the summary and by a linear scan.
+    for (const bool with_summary : {true, false}) {
+      SCOPED_TRACE(with_summary ? "through the summary" : "by a linear scan");
+      std::vector<ReadMessage> all;
+      ReadReport read_report;
+      const Status s = read_skipping(corrupt, with_summary, chunks, all, read_report);
+      ASSERT_TRUE(s.ok()) << s.to_string();
+      EXPECT_TRUE(read_report.skipped_chunks.empty());
+      EXPECT_EQ(all.size(), golden_messages().size());
+    }
+    // In place, a complete and verified result replaces the input.
+    RepairReport in_place;
+    ASSERT_TRUE(repair_file(input, input, in_place).ok());
+    EXPECT_EQ(in_place.written_to, input);
+    for (const auto& p : {input, output}) std::filesystem::remove(p);
+  }
+}
+
+TEST(McapMalformed, RepairResumesAtTheNextIntactChunkWhenFramingIsLost) {
+  std::vector<ChunkIndex> chunks;
+  const auto bytes = nine_chunk_bag(chunks, 9);
+  ASSERT_EQ(chunks.size(), 9u);
+  const ChunkIndex& victim = chunks[4];
+  {
+    SCOPED_TRACE("a chunk whose length field and compression name length are both corrupt");
+    auto corrupt = bytes;
+    detail::write_u64_at(corrupt.data() + victim.chunk_start_offset + 1, std::uint64_t{1} << 40);
+    detail::write_u32_at(corrupt.data() + victim.chunk_start_offset + kRecordPrefixSize + 28,
+                         0xFFFFFFF0u);
+    const auto input = temp_path("framing.mcap");
+    const auto output = temp_path("framing_out.mcap");
+    write_bytes(input, corrupt);
+    RepairReport report;
+    ASSERT_TRUE(repair_file(input, output, report).ok());
+    ASSERT_EQ(report.skipped_chunks.size(), 1u);
+    EXPECT_EQ(report.skipped_chunks[0].offset, victim.chunk_start_offset);
+    EXPECT_NE(report.skipped_chunks[0].problem.find("next intact record, at offset " +
+                                                    std::to_string(chunks[5].chunk_start_offset)),
+              std::string::npos)
+        << report.skipped_chunks[0].problem;
+    EXPECT_EQ(report.chunks_kept, 8u);
+    EXPECT_EQ(report.messages_kept, messages_outside(victim));
+    EXPECT_TRUE(report.stopped_because.empty()) << report.stopped_because;
+    for (const auto& p : {input, output}) std::filesystem::remove(p);
+  }
+  {
+    SCOPED_TRACE("a Message Index record whose length field is corrupt");
+    auto corrupt = bytes;
+    const std::uint64_t index_at = victim.chunk_start_offset + victim.chunk_length;
+    ASSERT_EQ(corrupt[index_at], std::byte{static_cast<unsigned char>(Opcode::message_index)});
+    detail::write_u64_at(corrupt.data() + index_at + 1, std::uint64_t{1} << 40);
+    const auto input = temp_path("index_length.mcap");
+    const auto output = temp_path("index_length_out.mcap");
+    write_bytes(input, corrupt);
+    RepairReport report;
+    ASSERT_TRUE(repair_file(input, output, report).ok());
+    ASSERT_EQ(report.skipped_chunks.size(), 1u);
+    EXPECT_EQ(report.skipped_chunks[0].offset, index_at);
+    EXPECT_EQ(report.chunks_kept, 9u);  // the indexes are rebuilt: no message is lost
+    EXPECT_EQ(report.messages_kept, golden_messages().size());
+    for (const auto& p : {input, output}) std::filesystem::remove(p);
+  }
+}
+
 TEST(McapMalformed, ASkippingReaderGoesOnPastACorruptChunk) {
   std::vector<ChunkIndex> chunks;
   const auto bytes = nine_chunk_bag(chunks, 2);
   ASSERT_EQ(chunks.size(), 9u);
   const ChunkIndex victim = chunks[2];
-  ReaderOptions skipping;
-  skipping.skip_corrupt_chunks = true;
   for (const bool with_summary : {true, false}) {
     SCOPED_TRACE(with_summary ? "through the summary" : "by a linear scan");
-    auto input = bytes;
-    if (!with_summary) input.resize(chunks.back().chunk_start_offset + chunks.back().chunk_length);
-    Reader reader;
-    ASSERT_TRUE(reader.open_memory(input, skipping).ok());
     std::vector<ReadMessage> got;
     ReadReport report;
-    ReadOptions options;
-    options.allow_truncated = true;
-    const Status s = read_all(reader, got, options, &report);
+    const Status s = read_skipping(bytes, with_summary, chunks, got, report);
     ASSERT_TRUE(s.ok()) << s.to_string();
     EXPECT_EQ(report.used_summary, with_summary);
     ASSERT_EQ(report.skipped_chunks.size(), 1u);

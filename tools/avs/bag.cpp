@@ -229,6 +229,10 @@ int run_repair(const std::string& file, std::string output) {
     std::cout << "  left out the corrupt chunk at offset " << chunk.offset << ": " << chunk.problem
               << "\n";
   }
+  if (report.chunk_lengths_corrected > 0) {
+    std::cout << "  corrected the length field of " << report.chunk_lengths_corrected
+              << " chunk(s) (kept, framed by their own fields)\n";
+  }
   if (!report.stopped_because.empty())
     std::cout << "  scan stopped: " << report.stopped_because << "\n";
   if (report.input_had_summary) {

@@ -127,6 +127,134 @@ Status Decoder::read_record(std::uint64_t offset, std::uint64_t limit, ByteBuffe
   return source_->view(offset + kRecordPrefixSize, length, scratch, out.content);
 }
 
+Status Decoder::view_record(std::uint64_t offset, std::uint64_t length, ByteBuffer& scratch,
+                            RecordView& out) {
+  out.offset = offset;
+  if (Status s = source_->view(offset, 1, scratch, out.content); !s.ok()) return s;
+  out.opcode = static_cast<std::uint8_t>(out.content[0]);
+  return source_->view(offset + kRecordPrefixSize, length, scratch, out.content);
+}
+
+namespace {
+
+bool allowed_in_data_section(std::uint8_t opcode) {
+  switch (static_cast<Opcode>(opcode)) {
+    case Opcode::schema:
+    case Opcode::channel:
+    case Opcode::message:
+    case Opcode::chunk:
+    case Opcode::message_index:
+    case Opcode::attachment:
+    case Opcode::metadata:
+    case Opcode::data_end:
+      return true;
+    default:
+      return opcode >= 0x80;  // private records
+  }
+}
+
+bool opens_the_summary(std::uint8_t opcode) {
+  switch (static_cast<Opcode>(opcode)) {
+    case Opcode::footer:
+    case Opcode::schema:
+    case Opcode::channel:
+    case Opcode::chunk_index:
+    case Opcode::attachment_index:
+    case Opcode::statistics:
+    case Opcode::metadata_index:
+    case Opcode::summary_offset:
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Chunk content: start time, end time, uncompressed size (u64 each), CRC (u32), compression
+// name (u32 length + bytes), records (u64 length + bytes).
+constexpr std::uint64_t kChunkCompressionLengthAt = 28;
+constexpr std::uint64_t kChunkFixedFields = 40;
+
+}  // namespace
+
+std::uint64_t Decoder::chunk_framed_by_its_fields(std::uint64_t offset, std::uint64_t limit) {
+  const std::uint64_t fields_at = offset + kRecordPrefixSize;
+  if (fields_at > limit || limit - fields_at < kChunkFixedFields) return 0;
+  ByteBuffer probe;
+  std::span<const std::byte> bytes;
+  if (!source_->view(fields_at + kChunkCompressionLengthAt, 4, probe, bytes).ok()) return 0;
+  const std::uint64_t name_length = load_u32(bytes.data());
+  const std::uint64_t room = limit - fields_at - kChunkFixedFields;
+  if (name_length > room) return 0;
+  if (!source_->view(fields_at + kChunkFixedFields - 8 + name_length, 8, probe, bytes).ok()) {
+    return 0;
+  }
+  const std::uint64_t records_length = load_u64(bytes.data());
+  if (records_length > room - name_length) return 0;
+  return kChunkFixedFields + name_length + records_length;
+}
+
+bool Decoder::plausible_record(std::uint64_t offset, std::uint64_t limit) {
+  if (offset == limit) return true;
+  if (offset > limit || limit - offset < kRecordPrefixSize) return false;
+  ByteBuffer probe;
+  std::span<const std::byte> prefix;
+  if (!source_->view(offset, kRecordPrefixSize, probe, prefix).ok()) return false;
+  return allowed_in_data_section(static_cast<std::uint8_t>(prefix[0])) &&
+         load_u64(prefix.data() + 1) <= limit - offset - kRecordPrefixSize;
+}
+
+std::uint64_t Decoder::next_intact_record(std::uint64_t from, std::uint64_t limit) {
+  constexpr std::uint64_t kWindow = 1 << 16;
+  ByteBuffer window_buffer;
+  ByteBuffer raw;
+  ByteBuffer decompressed;
+  // Bounded work: a hostile file may hold many candidates claiming large chunks.
+  std::uint64_t budget_bytes = options_.max_loaded_uncompressed_bytes;
+  for (std::uint64_t start = from; start < limit && limit - start >= kRecordPrefixSize;
+       start += kWindow) {
+    // Each window overlaps the next by a prefix, so that no candidate straddles two unseen.
+    const std::uint64_t length = std::min(limit - start, kWindow + kRecordPrefixSize - 1);
+    std::span<const std::byte> window;
+    if (!source_->view(start, length, window_buffer, window).ok()) return limit;
+    for (std::uint64_t i = 0; i + kRecordPrefixSize <= window.size() && i < kWindow; ++i) {
+      const auto opcode = static_cast<Opcode>(window[i]);
+      if (opcode != Opcode::chunk && opcode != Opcode::data_end) continue;
+      const std::uint64_t at_offset = start + i;
+      const std::uint64_t declared = load_u64(window.data() + i + 1);
+      if (declared > limit - at_offset - kRecordPrefixSize) continue;
+      const std::uint64_t end = at_offset + kRecordPrefixSize + declared;
+      if (opcode == Opcode::data_end) {
+        if (declared != 4 || limit - end < kRecordPrefixSize) continue;
+        std::span<const std::byte> next;
+        if (!source_->view(end, kRecordPrefixSize, raw, next).ok()) return limit;
+        if (opens_the_summary(static_cast<std::uint8_t>(next[0])) &&
+            load_u64(next.data() + 1) <= limit - end - kRecordPrefixSize) {
+          return at_offset;
+        }
+        continue;
+      }
+      // A Chunk: its length field and its fields agree, it decompresses, its CRC (when it has
+      // one) matches and its records parse.
+      if (chunk_framed_by_its_fields(at_offset, limit) != declared) continue;
+      RecordView record;
+      if (!view_record(at_offset, declared, raw, record).ok()) return limit;
+      if (record.content.size() >= 24) {
+        const std::uint64_t uncompressed = load_u64(record.content.data() + 16);
+        if (uncompressed > budget_bytes) return limit;
+        budget_bytes -= uncompressed;
+      }
+      ChunkView chunk;
+      if (!load_chunk(record, decompressed, chunk).ok()) continue;
+      if (chunk.uncompressed_crc == 0 &&
+          !walk_chunk(chunk, [](std::uint64_t, const MessageFields&) { return Status{}; }).ok()) {
+        continue;
+      }
+      return at_offset;
+    }
+  }
+  return limit;
+}
+
 Status Decoder::open() {
   const std::uint64_t size = source_->size();
   if (size < kMagicSize) {
@@ -499,7 +627,40 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
       result.truncation_detail = missing.message();
       break;
     }
-    if (Status s = read_record(pos, size, scratch, record); !s.ok()) {
+    Status read = read_record(pos, size, scratch, record);
+    if (options_.skip_corrupt_chunks && read.code() != StatusCode::io_error) {
+      bool ends_well = read.ok();
+      if (record.opcode == static_cast<std::uint8_t>(Opcode::chunk)) {
+        // The chunk's own fields frame it too. Where they disagree with its length field, the
+        // one that ends at a record is believed, the fields first: a length covering the next
+        // chunk would otherwise hide it (issue 20 section 2).
+        const std::uint64_t framed = chunk_framed_by_its_fields(pos, size);
+        if (!read.ok() || framed != record.content.size()) {
+          if (framed != 0 && plausible_record(pos + kRecordPrefixSize + framed, size)) {
+            read = view_record(pos, framed, scratch, record);
+            if (read.ok()) ++result.chunk_lengths_corrected;
+            ends_well = read.ok();
+          } else {
+            ends_well = read.ok() && plausible_record(pos + record.total_length(), size);
+          }
+        }
+      }
+      if (!ends_well) {
+        const std::uint64_t next = next_intact_record(pos + 1, size);
+        if (next < size) {
+          result.skipped_chunks.push_back(
+              {pos, std::string(opcode_name(record.opcode)) + " record at " + at(pos) +
+                        ": its framing is lost (" +
+                        (read.ok() ? std::string("it does not end at a record") : read.message()) +
+                        "); left out up to the next intact record, at " + at(next)});
+          last_chunk = nullptr;
+          pos = next;
+          result.last_complete_offset = pos;
+          continue;
+        }
+      }
+    }
+    if (Status s = read; !s.ok()) {
       if (s.code() != StatusCode::truncated || !allow_truncated) return s;
       result.truncated = true;
       result.truncated_at = pos;
@@ -516,8 +677,9 @@ Status Decoder::scan(ScanResult& result, bool allow_truncated, const MessageCall
       Cursor c(record.content, base, where);
       std::uint32_t stored = c.u32();
       if (!c.ok()) return c.status();
-      // A skipped chunk's bytes are still in the CRC: it cannot match, and says nothing more.
-      if (stored != 0 && result.skipped_chunks.empty()) {
+      // A skipped chunk's bytes are still in the CRC, and a corrected length field is not the
+      // file's: it cannot match, and says nothing more.
+      if (stored != 0 && result.skipped_chunks.empty() && result.chunk_lengths_corrected == 0) {
         if (stored != crc) {
           return Status(StatusCode::crc_mismatch, "data section CRC up to the Data End record at " +
                                                       at(pos) + " is " + hex(crc) +
@@ -746,8 +908,14 @@ Status Decoder::read_indexed(const Summary& summary, std::uint64_t data_limit,
     slot.next = 0;
     slot.order = order;
     RecordView record;
-    if (Status s = read_record(index.chunk_start_offset,
-                               index.chunk_start_offset + index.chunk_length, slot.raw, record);
+    // Skipping corrupt chunks, the summary's length (under the summary CRC) is believed over a
+    // chunk's own length field: a flipped bit there costs nothing.
+    const bool by_index = options_.skip_corrupt_chunks && index.chunk_length >= kRecordPrefixSize;
+    if (Status s =
+            by_index ? view_record(index.chunk_start_offset, index.chunk_length - kRecordPrefixSize,
+                                   slot.raw, record)
+                     : read_record(index.chunk_start_offset,
+                                   index.chunk_start_offset + index.chunk_length, slot.raw, record);
         !s.ok()) {
       free_slots.push_back(slot_id);
       return Status(StatusCode::malformed, where + ": " + s.message());

@@ -72,6 +72,20 @@ class Decoder {
  private:
   Status read_record(std::uint64_t offset, std::uint64_t limit, ByteBuffer& scratch,
                      RecordView& out);
+  /// The record at `offset` taken as `length` content bytes, whatever its length field says.
+  Status view_record(std::uint64_t offset, std::uint64_t length, ByteBuffer& scratch,
+                     RecordView& out);
+  // Resynchronisation (ReaderOptions::skip_corrupt_chunks): a record's length field is one u64
+  // among its bytes, and a flipped bit in it must not cost every record after it.
+  /// The content length a Chunk at `offset` has by its own fields (40 bytes of fixed fields, the
+  /// compression name, the records), when they fit before `limit`; 0 when they do not.
+  std::uint64_t chunk_framed_by_its_fields(std::uint64_t offset, std::uint64_t limit);
+  /// Whether a data-section record can start at `offset`: an opcode allowed there and a length
+  /// that fits before `limit`, or `offset == limit` (a file that ends after a record).
+  bool plausible_record(std::uint64_t offset, std::uint64_t limit);
+  /// The first offset from `from` at which an intact Chunk starts (it loads, its CRC checked)
+  /// or a Data End followed by a summary record or the Footer; `limit` when there is none.
+  std::uint64_t next_intact_record(std::uint64_t from, std::uint64_t limit);
   Status load_chunk(const RecordView& record, ByteBuffer& decompressed, ChunkView& out);
   Status add_schema(Schema schema, std::uint64_t offset);
   Status add_channel(Channel channel, std::uint64_t offset);

@@ -137,6 +137,7 @@ Status repair_file(const std::filesystem::path& input, const std::filesystem::pa
   ScanResult scanned;
   Status scan_status = scanner.scan(scanned, /*allow_truncated=*/true, {}, hook);
   report.skipped_chunks = scanned.skipped_chunks;
+  report.chunk_lengths_corrected = scanned.chunk_lengths_corrected;
   if (!scan_status.ok() && scan_status.code() == StatusCode::io_error) {
     (void)file.close();
     std::remove(temporary.c_str());

@@ -32,6 +32,9 @@ struct ReaderOptions {
   /// A chunk whose record framing is intact but whose content is not (CRC mismatch, corrupt
   /// compression, a bad record inside, over the size limits) is skipped, said in the report
   /// (ScanResult / ReadReport::skipped_chunks), and reading goes on with the next record.
+  /// A Chunk whose length field is corrupt is read by its own fields when they end at a record;
+  /// a record whose framing is lost is skipped up to the next intact Chunk (or Data End), the
+  /// region left out reported as a skipped chunk.
   /// Off: such a chunk is an error. `bag play` and `bag repair` skip; strict readers do not.
   bool skip_corrupt_chunks = false;
 };
@@ -78,6 +81,9 @@ struct ScanResult {
   /// With ReaderOptions::skip_corrupt_chunks: the chunks left out (the data section CRC then
   /// cannot match and is not an error).
   std::vector<SkippedChunk> skipped_chunks;
+  /// With ReaderOptions::skip_corrupt_chunks: Chunk records whose length field disagreed with
+  /// the chunk's own fields and that were read by their fields (the data CRC then cannot match).
+  std::uint64_t chunk_lengths_corrected = 0;
 };
 
 /// Called per message; return false to stop early.
@@ -135,6 +141,8 @@ struct RepairReport {
   std::string stopped_because;
   /// Chunks left out because their content is corrupt (the records after them are kept).
   std::vector<SkippedChunk> skipped_chunks;
+  /// Chunks kept whose length field was corrupt: written with the length their fields give.
+  std::uint64_t chunk_lengths_corrected = 0;
   /// The input's own summary's message count, when it had a valid one.
   std::uint64_t input_summary_messages = 0;
   /// Where the result is: `output`, or `<output>.repaired.mcap` when it would have replaced
