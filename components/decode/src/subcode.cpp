@@ -31,9 +31,10 @@ SubcodeRefiner::SubcodeRefiner(SubcodeParams params) : params_(params) {
 
 namespace {
 
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_THREAD__)
 // Plain loops over arrays: the compiler vectorises them; with AVX2 when the CPU has it (the
-// default build has no -march flag).
+// default build has no -march flag). Not under TSan: the clones' ifunc resolver is instrumented
+// and runs at relocation time, before TSan is initialised (`avs` crashed before main).
 #define AVS_SUBCODE_CLONES __attribute__((target_clones("avx2", "default")))
 #else
 #define AVS_SUBCODE_CLONES
