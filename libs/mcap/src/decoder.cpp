@@ -171,6 +171,7 @@ bool opens_the_summary(std::uint8_t opcode) {
 
 // Chunk content: start time, end time, uncompressed size (u64 each), CRC (u32), compression
 // name (u32 length + bytes), records (u64 length + bytes).
+constexpr std::uint64_t kChunkUncompressedSizeAt = 16;
 constexpr std::uint64_t kChunkCompressionLengthAt = 28;
 constexpr std::uint64_t kChunkFixedFields = 40;
 
@@ -208,7 +209,7 @@ std::uint64_t Decoder::next_intact_record(std::uint64_t from, std::uint64_t limi
   ByteBuffer window_buffer;
   ByteBuffer raw;
   ByteBuffer decompressed;
-  // Bounded work: a hostile file may hold many candidates claiming large chunks.
+  // Bounded work: a hostile file may hold many candidates that decompress to the chunk limit.
   std::uint64_t budget_bytes = options_.max_loaded_uncompressed_bytes;
   for (std::uint64_t start = from; start < limit && limit - start >= kRecordPrefixSize;
        start += kWindow) {
@@ -235,11 +236,14 @@ std::uint64_t Decoder::next_intact_record(std::uint64_t from, std::uint64_t limi
       }
       // A Chunk: its length field and its fields agree, it decompresses, its CRC (when it has
       // one) matches and its records parse.
-      if (chunk_framed_by_its_fields(at_offset, limit) != declared) continue;
+      // (framed is 0 when the fields do not fit: never a match, a Chunk has 40 bytes of fields.)
+      const std::uint64_t framed = chunk_framed_by_its_fields(at_offset, limit);
+      if (framed == 0 || framed != declared) continue;
       RecordView record;
       if (!view_record(at_offset, declared, raw, record).ok()) return limit;
-      if (record.content.size() >= 24) {
-        const std::uint64_t uncompressed = load_u64(record.content.data() + 16);
+      // (Above the chunk limit load_chunk refuses it before decompressing: nothing to count.)
+      const std::uint64_t uncompressed = load_u64(record.content.data() + kChunkUncompressedSizeAt);
+      if (uncompressed <= options_.max_chunk_uncompressed_bytes) {
         if (uncompressed > budget_bytes) return limit;
         budget_bytes -= uncompressed;
       }
