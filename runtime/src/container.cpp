@@ -15,7 +15,9 @@
 #include "avs/runtime/topic_name.hpp"
 #include "diagnostic_msgs.h"
 #include "parameter_service.hpp"
+#include "recorder_acks.hpp"
 #include "rosgraph_msgs.h"
+#include "writer_counts.hpp"
 
 namespace avs::runtime {
 
@@ -33,6 +35,9 @@ struct TopicEntry {
   const msg::TypeEntry* type = nullptr;
   std::unique_ptr<dds::Topic> topic;
   std::unique_ptr<dds::Writer> writer;
+  /// What the writer has written, for /avs/writer_counts (recorders reconcile against it).
+  WriterTally tally;
+  std::uint32_t history_depth = 0;  ///< the writer's KEEP_LAST depth
   /// The writer keeps its last samples for readers that match later (transient local):
   /// they must reach the DDS writer even when no remote reader is matched yet.
   bool latched = false;
@@ -70,6 +75,8 @@ struct Container::Impl {
   Time last_diagnostics{};  ///< clock time of the previous /diagnostics report
   std::unique_ptr<ParameterService> parameter_service;
   std::unique_ptr<RosDiscoveryWriter> ros_discovery;
+  std::unique_ptr<WriterCountsPublisher> writer_counts;
+  std::unique_ptr<RecorderAcks> recorder_acks;
   /// Serialised <-> typed samples, per type, for components with open ports.
   std::map<std::string, std::unique_ptr<dds::CdrCodec>> codecs;
   const dds::CdrCodec& codec(const msg::TypeEntry& type);
@@ -337,7 +344,8 @@ class LocalPublisher final : public PublisherCore {
       scheduler_.post(sub.lane, [deliver = sub.deliver, sample] { deliver(sample); });
     }
     // Serialise only when a reader in another participant wants it, now or (latched) later.
-    if (topic_.latched || topic_.writer->matched_readers() > 0) topic_.writer->write(sample.get());
+    topic_.tally.publish(*topic_.writer, sample.get(),
+                         topic_.latched || topic_.writer->matched_readers() > 0);
   }
   const std::string& topic() const override { return topic_.dds_name; }
   std::size_t reader_count() const override {
@@ -358,6 +366,7 @@ TopicEntry& ComponentHost::add_publication(const std::string& dds_name, const ms
   if (!topic.writer) {
     topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
     topic.latched = qos.durability == Durability::transient_local;
+    topic.history_depth = qos.depth;
   }
   published.push_back(&topic);
   return topic;
@@ -693,6 +702,33 @@ int Container::run() {
                         [&c, &topic] { c.publish_diagnostics(*topic.writer); });
   }
 
+  // Counts of what the components' writers wrote, for recorders in other processes to
+  // reconcile their receipts against (issue 20 section 6, docs/bag.md "Loss accounting").
+  {
+    std::vector<const TopicEntry*> published;  // each writer once (components may share one)
+    for (auto& host : c.hosts) {
+      for (const TopicEntry* t : host->published)
+        if (std::find(published.begin(), published.end(), t) == published.end())
+          published.push_back(t);
+    }
+    std::vector<WriterCountsPublisher::Entry> entries;
+    std::vector<RecorderAcks::Watched> watched;
+    for (const TopicEntry* t : published) {
+      entries.push_back({t->writer.get(), from_dds_topic_name(t->dds_name), &t->tally});
+      watched.push_back({t->writer.get(), &t->tally, t->history_depth});
+    }
+    c.writer_counts =
+        std::make_unique<WriterCountsPublisher>(c.participant, spec_.name, std::move(entries));
+    scheduler.add_timer(0, std::chrono::milliseconds(100),
+                        [&c, &scheduler] { c.writer_counts->publish(scheduler.now()); });
+    // Lockstep time is the graph's own: it waits for recorders rather than outrun them.
+    if (mode == TimeMode::sim_lockstep && graph_.clock.wait_for_recorders) {
+      c.recorder_acks = std::make_unique<RecorderAcks>(c.participant, std::move(watched), c.log,
+                                                       std::chrono::seconds(2));
+      scheduler.before_time_advance([&c] { c.recorder_acks->wait(); });
+    }
+  }
+
   // DDS inputs from other processes.
   c.waitset = std::make_unique<dds::WaitSet>(c.participant);
   for (auto& [name, topic] : c.topics) {
@@ -772,6 +808,12 @@ int Container::run() {
       c.log.error("component '", host.instance().name, "' failed to shut down: ", e.what());
       c.failed = true;
     }
+  }
+  // The final counts: a recorder still running ends its reconciliation with them.
+  try {
+    c.writer_counts->publish(scheduler.now());
+  } catch (const std::exception& e) {
+    c.log.warn("final /avs/writer_counts not published: ", e.what());
   }
   c.log.info(c.failed ? "stopped after a failure" : "stopped");
   return c.failed ? 1 : 0;

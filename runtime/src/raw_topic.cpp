@@ -95,47 +95,92 @@ std::string EndpointQos::describe() const {
   return s;
 }
 
-PublicationDiscovery::PublicationDiscovery(const Participant& participant)
-    : reader_(check_dds(
-          dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
-          "read DCPSPublication")) {
+EndpointDiscovery::EndpointDiscovery(const Participant& participant, EndpointKinds kinds) {
+  if (kinds != EndpointKinds::readers) {
+    publications_ = Entity(check_dds(
+        dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
+        "read DCPSPublication"));
+  }
+  if (kinds != EndpointKinds::writers) {
+    subscriptions_ = Entity(check_dds(
+        dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr),
+        "read DCPSSubscription"));
+  }
   dds_guid_t own{};
   check_dds(dds_get_guid(participant.get(), &own), "participant guid");
   std::copy(std::begin(own.v), std::end(own.v), own_.begin());
 }
 
-std::vector<DiscoveredPublication> PublicationDiscovery::poll() {
-  std::vector<DiscoveredPublication> found;
+std::vector<DiscoveredEndpoint> EndpointDiscovery::update() {
+  std::vector<DiscoveredEndpoint> appeared;
+  if (publications_) take(publications_.get(), true, appeared);
+  if (subscriptions_) take(subscriptions_.get(), false, appeared);
+  return appeared;
+}
+
+void EndpointDiscovery::take(dds_entity_t reader, bool is_writer,
+                             std::vector<DiscoveredEndpoint>& appeared) {
+  const char* what = is_writer ? "take DCPSPublication" : "take DCPSSubscription";
   for (;;) {
     constexpr int kBatch = 64;
     void* samples[kBatch] = {};
     dds_sample_info_t infos[kBatch];
-    const int n =
-        check_dds(dds_take(reader_.get(), samples, infos, kBatch, kBatch), "take DCPSPublication");
+    const int n = check_dds(dds_take(reader, samples, infos, kBatch, kBatch), what);
     for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data || infos[i].instance_state != DDS_IST_ALIVE) continue;
       const auto* ep = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
+      Key key{{}, is_writer};
+      std::copy(std::begin(ep->key.v), std::end(ep->key.v), key.first.begin());
+      if (infos[i].instance_state != DDS_IST_ALIVE) {
+        endpoints_.erase(key);  // an invalid sample still carries the key
+        continue;
+      }
+      if (!infos[i].valid_data) continue;
       if (std::equal(own_.begin(), own_.end(), std::begin(ep->participant_key.v))) continue;
       const std::string topic = ep->topic_name;
       if (topic.rfind("DCPS", 0) == 0) continue;
-      DiscoveredPublication p;
-      p.topic = topic;
-      p.type_name = ep->type_name;
-      std::copy(std::begin(ep->key.v), std::end(ep->key.v), p.key.begin());
-      p.qos = EndpointQos::from_dds(ep->qos);
-      found.push_back(std::move(p));
+      DiscoveredEndpoint e;
+      e.is_writer = is_writer;
+      e.key = key.first;
+      std::copy(std::begin(ep->participant_key.v), std::end(ep->participant_key.v),
+                e.participant.begin());
+      e.topic = topic;
+      e.type_name = ep->type_name != nullptr ? ep->type_name : "";
+      dds_qos_t* copy = dds_create_qos();
+      if (ep->qos != nullptr) dds_copy_qos(copy, ep->qos);
+      e.qos = std::shared_ptr<const dds_qos_t>(
+          copy, [](const dds_qos_t* q) { dds_delete_qos(const_cast<dds_qos_t*>(q)); });
+      const bool is_new = endpoints_.count(key) == 0;
+      endpoints_[key] = e;
+      if (is_new) appeared.push_back(std::move(e));
     }
-    if (n > 0) dds_return_loan(reader_.get(), samples, n);
+    if (n > 0) dds_return_loan(reader, samples, n);
     if (n < kBatch) break;
+  }
+}
+
+PublicationDiscovery::PublicationDiscovery(const Participant& participant)
+    : discovery_(participant, EndpointKinds::writers) {}
+
+std::vector<DiscoveredPublication> PublicationDiscovery::poll() {
+  std::vector<DiscoveredPublication> found;
+  for (const DiscoveredEndpoint& e : discovery_.update()) {
+    DiscoveredPublication p;
+    p.topic = e.topic;
+    p.type_name = e.type_name;
+    p.key = e.key;
+    p.qos = EndpointQos::from_dds(e.qos.get());
+    found.push_back(std::move(p));
   }
   return found;
 }
 
 RawReader::RawReader(const Participant& participant, const msg::TypeEntry& type,
-                     const std::string& dds_topic, const EndpointQos& qos)
+                     const std::string& dds_topic, const EndpointQos& qos,
+                     std::string_view user_data)
     : topic_(dds_topic) {
   Qos q = qos.to_dds();
   participant.apply_partition(q.get());
+  if (!user_data.empty()) dds_qset_userdata(q.get(), user_data.data(), user_data.size());
   topic_entity_ = Entity(check_dds(
       dds_create_topic(participant.get(), type.descriptor, dds_topic.c_str(), nullptr, nullptr),
       "create topic " + dds_topic + " (" + type.dds_name + ")"));

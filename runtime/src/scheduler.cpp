@@ -203,6 +203,13 @@ void Scheduler::wait_locked(std::unique_lock<std::mutex>& lock, int lane_index) 
       changed_.wait_for(lock, std::chrono::milliseconds(100));
       break;
     case TimeMode::sim_lockstep: {
+      if (all_idle_locked() && !timers_.empty() && before_advance_) {
+        lane.idle = false;  // no other lane advances meanwhile
+        lock.unlock();
+        before_advance_();
+        lock.lock();
+        lane.idle = true;
+      }
       if (all_idle_locked() && !timers_.empty()) {
         // Every lane is idle and nothing is due: jump to the earliest deadline.
         Time t{timers_.begin()->first.first};

@@ -31,6 +31,9 @@ start_live "$out/live" "${args[@]}" duration_s:=120
 wait_for "drive fault, error code 0x5000"
 "$avs" head reset --wait 20 || fail "avs head reset failed"
 wait_for "link and drives healthy again"
+# Torque comes back a few stable cycles after that line: on a loaded machine a stop right
+# away could come first (the run's CSV then ends before it).
+sleep 1
 stop_live
 csv="$out/live/drive.csv"
 [ -s "$csv" ] || fail "no report from the live run"

@@ -133,8 +133,11 @@ std::vector<Grant> grants_of(const deploy::Deployment& d) {
   const auto& registry = runtime::ComponentRegistry::instance();
   for (const auto& c : d.graph.containers) {
     Grant g{c.name,
-            {"rt/diagnostics", "rt/clock", "rt/parameter_events", "ros_discovery_info"},
-            {"rt/clock"}};
+            // Every container counts its writers for recorders (/avs/writer_counts) and, in
+            // lockstep, reads what recorders have (/avs/recorder_progress, docs/bag.md).
+            {"rt/diagnostics", "rt/clock", "rt/parameter_events", "ros_discovery_info",
+             "rt/avs/writer_counts"},
+            {"rt/clock", "rt/avs/recorder_progress"}};
     for (const auto& comp : c.components) {
       // Each component is a ROS 2 node answering its parameter services (docs/operate.md).
       const std::string node = runtime::resolve_topic_name(d.graph.ns, comp.name);

@@ -14,11 +14,14 @@
 #include <thread>
 
 #include "avs/bag/qos_yaml.hpp"
+#include "avs/bag/receipt_ledger.hpp"
 #include "avs/introspection/type_database.hpp"
 #include "avs/mcap/writer.hpp"
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/raw_topic.hpp"
+#include "avs/runtime/sample.hpp"
 #include "avs/runtime/topic_name.hpp"
+#include "avs_msgs.h"
 
 namespace avs::bag {
 
@@ -38,6 +41,11 @@ std::string ros_topic_of(const std::string& name) {
   if (name.rfind("rt/", 0) == 0) return runtime::from_dds_topic_name(name);
   return runtime::resolve_topic_name("/", name);
 }
+
+/// Stopping: how long to wait for every reporting writer's next count (reports come every
+/// 0.1 s), then how long to keep taking for the samples those counts name.
+constexpr auto kFinalReportWait = std::chrono::milliseconds(500);
+constexpr auto kFinalSampleGrace = std::chrono::milliseconds(100);
 
 std::filesystem::path split_path(const std::filesystem::path& first, int index) {
   if (index == 0) return first;
@@ -65,7 +73,54 @@ struct RecordedTopic {
       queue_dropped{0}, write_failed{0};
   std::uint64_t written_to_open_file = 0;  // writer thread only
   std::atomic<std::uint32_t> incompatible{0};
+  /// Receipts per writer against the writers' counts; the writer of each publication handle.
+  mutable std::mutex ledger_mutex;
+  ReceiptLedger ledger;
+  std::map<dds_instance_handle_t, WriterGid> writer_of;  // reader thread only
+
+  /// The counters of the report (call with the recorder's topics_mutex held).
+  TopicCounters counters() const {
+    TopicCounters c;
+    c.topic = ros_topic;
+    c.type = ros_type;
+    c.qos = requested_qos;
+    c.publishers = writers.size();
+    c.received = received;
+    c.written = written;
+    c.bytes = bytes;
+    c.dds_lost = dds_lost;
+    c.dds_rejected = dds_rejected;
+    c.queue_dropped = queue_dropped;
+    c.write_failed = write_failed;
+    c.incompatible_writers = incompatible;
+    c.skipped_because = skipped_because;
+    std::lock_guard lock(ledger_mutex);
+    for (const auto& [gid, r] : ledger.results()) {
+      if (!r.reconciled) {
+        ++c.writers_unreconciled;
+        continue;
+      }
+      ++c.writers_reconciled;
+      c.expected_in_window += r.expected;
+      c.missing += r.missing;
+    }
+    return c;
+  }
 };
+
+namespace {
+
+std::string hex(const WriterGid& gid) {
+  static const char* digits = "0123456789abcdef";
+  std::string out;
+  for (std::uint8_t b : gid) {
+    out += digits[b >> 4];
+    out += digits[b & 15];
+  }
+  return out;
+}
+
+}  // namespace
 
 struct QueuedSample {
   RecordedTopic* topic;
@@ -83,6 +138,12 @@ struct Recorder::Impl {
   std::unique_ptr<dds::PublicationDiscovery> discovery;
   std::unique_ptr<dds::WaitSet> waitset;
   std::vector<dds::Entity> conditions;
+  /// The writers' counts (/avs/writer_counts), read by the reader thread.
+  dds::Entity counts_topic, counts_reader;
+  /// What it has received, per writer (/avs/recorder_progress), for lockstep graphs that wait
+  /// for it (runtime/src/recorder_acks.hpp); sent when it changed.
+  dds::Entity progress_topic, progress_writer;
+  std::map<std::pair<RecordedTopic*, WriterGid>, std::uint64_t> progress_sent;
 
   mutable std::mutex topics_mutex;
   std::map<std::string, std::unique_ptr<RecordedTopic>> topics;  // by DDS name
@@ -163,7 +224,9 @@ struct Recorder::Impl {
         q.transient_local = p.qos.transient_local;
         q.keep_all = true;
         t->requested_qos = q.describe();
-        t->reader = std::make_unique<dds::RawReader>(participant, *type, p.topic, q);
+        // Marked as a recorder's: a lockstep graph's writers wait for its acknowledgements.
+        t->reader = std::make_unique<dds::RawReader>(participant, *type, p.topic, q,
+                                                     dds::kRecorderUserData);
         dds::Entity condition(
             runtime::check_dds(dds_create_readcondition(t->reader->get(), DDS_ANY_STATE),
                                "read condition on " + p.topic));
@@ -195,11 +258,108 @@ struct Recorder::Impl {
     }
     const std::uint64_t publish =
         info.source_timestamp > 0 ? static_cast<std::uint64_t>(info.source_timestamp) : now;
+    note_receipt(t, info);
     queue.push_back({&t, data, size, now, publish});
     const std::uint64_t q = queued_bytes.fetch_add(size, std::memory_order_relaxed) + size;
     if (q > queued_peak.load(std::memory_order_relaxed))
       queued_peak.store(q, std::memory_order_relaxed);
     queue_changed.notify_one();
+  }
+
+  /// Counts the sample against its writer (reconciled with the writer's reports).
+  void note_receipt(RecordedTopic& t, const dds_sample_info_t& info) {
+    auto it = t.writer_of.find(info.publication_handle);
+    if (it == t.writer_of.end()) {
+      WriterGid gid{};
+      if (dds_builtintopic_endpoint_t* ep =
+              dds_get_matched_publication_data(t.reader->get(), info.publication_handle)) {
+        std::copy(std::begin(ep->key.v), std::end(ep->key.v), gid.begin());
+        dds_builtintopic_free_endpoint(ep);
+      }
+      // A writer gone before its first sample was taken keeps the all-zero GUID: its samples
+      // are received but never reconciled (no report names that GUID).
+      it = t.writer_of.emplace(info.publication_handle, gid).first;
+    }
+    std::lock_guard lock(t.ledger_mutex);
+    t.ledger.received(it->second, info.source_timestamp);
+  }
+
+  /// Takes the writers' counts and hands each to the topic it counts.
+  void take_counts() {
+    constexpr int kBatch = 16;
+    for (;;) {
+      void* samples[kBatch] = {};
+      dds_sample_info_t infos[kBatch];
+      const dds_return_t n = dds_take(counts_reader.get(), samples, infos, kBatch, kBatch);
+      if (n <= 0) break;
+      {
+        std::lock_guard lock(topics_mutex);
+        for (int i = 0; i < n; ++i) {
+          if (!infos[i].valid_data) continue;
+          const auto* counts = static_cast<const avs_msgs_msg_dds__WriterCounts_*>(samples[i]);
+          for (std::uint32_t k = 0; k < counts->writers._length; ++k) {
+            const auto& w = counts->writers._buffer[k];
+            auto it = topics.find(runtime::to_dds_topic_name(runtime::get_string(w.topic)));
+            if (it == topics.end() || !it->second->reader) continue;
+            WriterGid gid;
+            std::copy(std::begin(w.writer_gid), std::end(w.writer_gid), gid.begin());
+            std::lock_guard ledger_lock(it->second->ledger_mutex);
+            it->second->ledger.reported(gid, {w.samples, w.last_source_timestamp_ns});
+          }
+        }
+      }
+      dds_return_loan(counts_reader.get(), samples, n);
+      if (n < kBatch) break;
+    }
+  }
+
+  /// Tells lockstep graphs what it has received, when that changed since the last time.
+  void publish_progress() {
+    if (!progress_writer) return;
+    struct Item {
+      std::string topic;
+      WriterGid gid;
+      ReceiptLedger::Progress p;
+    };
+    std::vector<Item> items;
+    {
+      std::lock_guard lock(topics_mutex);
+      for (auto& [name, t] : topics) {
+        if (!t->reader) continue;
+        std::lock_guard ledger_lock(t->ledger_mutex);
+        for (const auto& [gid, p] : t->ledger.progress()) {
+          std::uint64_t& sent = progress_sent[{t.get(), gid}];
+          if (sent == p.received) continue;
+          sent = p.received;
+          items.push_back({t->ros_topic, gid, p});
+        }
+      }
+    }
+    if (items.empty()) return;
+    auto sample = runtime::make_sample<msgs::avs_msgs::WriterCounts>();
+    runtime::set_string(sample->header.frame_id, "avs bag record");
+    runtime::resize_sequence(sample->writers, static_cast<std::uint32_t>(items.size()));
+    for (std::size_t i = 0; i < items.size(); ++i) {
+      auto& out = sample->writers._buffer[i];
+      std::copy(items[i].gid.begin(), items[i].gid.end(), std::begin(out.writer_gid));
+      runtime::set_string(out.topic, items[i].topic);
+      out.samples = items[i].p.received;
+      out.last_source_timestamp_ns = items[i].p.newest_source_time_ns;
+    }
+    runtime::check_dds(dds_write(progress_writer.get(), sample.get()),
+                       "write /avs/recorder_progress");
+  }
+
+  /// Reports received so far, per (topic, writer): to wait for fresh ones when stopping.
+  std::map<std::pair<RecordedTopic*, WriterGid>, std::uint64_t> report_counts() const {
+    std::map<std::pair<RecordedTopic*, WriterGid>, std::uint64_t> out;
+    std::lock_guard lock(topics_mutex);
+    for (auto& [name, t] : topics) {
+      std::lock_guard ledger_lock(t->ledger_mutex);
+      for (const auto& [gid, r] : t->ledger.results())
+        if (r.reports > 0) out[{t.get(), gid}] = r.reports;
+    }
+    return out;
   }
 
   void take_all() {
@@ -235,18 +395,43 @@ struct Recorder::Impl {
     try {
       std::vector<dds_attach_t> triggered(64);
       auto next_loss_check = std::chrono::steady_clock::now();
-      while (!stop_reading) {
-        waitset->wait(triggered.data(), triggered.size(), DDS_MSECS(50));
+      const auto read_once = [&](dds_duration_t wait) {
+        waitset->wait(triggered.data(), triggered.size(), wait);
         for (const auto& p : discovery->poll()) add_publication(p);
         take_all();
+        take_counts();
+        publish_progress();
+      };
+      while (!stop_reading) {
+        read_once(DDS_MSECS(50));
         if (std::chrono::steady_clock::now() >= next_loss_check) {
           update_loss();
           next_loss_check += std::chrono::milliseconds(200);
         }
       }
+      // Stopping: the reconciliation ends on counts sent after the stop, so every writer that
+      // reports gets up to kFinalReportWait to report again (its last sample may still be on
+      // its way after that: a little longer to take it). Samples that come meanwhile are
+      // recorded too. Not after a failure: the file is gone.
+      if (!finished) {
+        const auto before = report_counts();
+        const auto deadline = std::chrono::steady_clock::now() + kFinalReportWait;
+        while (std::chrono::steady_clock::now() < deadline) {
+          read_once(DDS_MSECS(20));
+          const auto now_counts = report_counts();
+          const bool all_fresh = std::all_of(before.begin(), before.end(), [&](const auto& kv) {
+            auto it = now_counts.find(kv.first);
+            return it != now_counts.end() && it->second > kv.second;
+          });
+          if (all_fresh) break;
+        }
+        const auto grace_end = std::chrono::steady_clock::now() + kFinalSampleGrace;
+        while (std::chrono::steady_clock::now() < grace_end) read_once(DDS_MSECS(10));
+      }
       // Whatever DDS still holds goes into the file too.
       for (const auto& p : discovery->poll()) add_publication(p);
       take_all();
+      take_counts();
       update_loss();
     } catch (const std::exception& e) {
       fail(std::string("reading DDS: ") + e.what());
@@ -301,10 +486,23 @@ struct Recorder::Impl {
     std::uint64_t total = 0;
     std::lock_guard lock(topics_mutex);
     for (auto& [name, t] : topics) {
-      const std::uint64_t lost = t->dds_lost + t->dds_rejected + t->queue_dropped;
-      total += lost;
+      const TopicCounters c = t->counters();
+      std::lock_guard ledger_lock(t->ledger_mutex);
+      for (const auto& [gid, r] : t->ledger.results()) {
+        if (!r.reconciled) continue;
+        // The window of each writer, anchored on two messages in this file (their publish
+        // times), so the figure can be checked from the file alone.
+        m["writer " + t->ros_topic + " " + hex(gid)] =
+            "window_start_ns=" + std::to_string(r.window_start_ns) +
+            " window_end_ns=" + std::to_string(r.window_end_ns) +
+            " expected=" + std::to_string(r.expected) +
+            " received=" + std::to_string(r.received_in_window) +
+            " missing=" + std::to_string(r.missing);
+      }
+      total += c.lost();
       m["received " + t->ros_topic] = std::to_string(t->received.load());
-      m["lost " + t->ros_topic] = std::to_string(t->dds_lost.load()) + " dds_lost, " +
+      m["lost " + t->ros_topic] = std::to_string(c.missing) + " missing (writers' counts), " +
+                                  std::to_string(t->dds_lost.load()) + " dds_lost, " +
                                   std::to_string(t->dds_rejected.load()) + " dds_rejected, " +
                                   std::to_string(t->queue_dropped.load()) + " queue_dropped";
     }
@@ -427,6 +625,52 @@ Recorder::Recorder(RecordOptions options) : impl_(std::make_unique<Impl>(std::mo
       dds_create_readcondition(m.discovery->reader(), DDS_ANY_STATE), "discovery read condition"));
   m.waitset->attach(discovery_condition.get(), 1);
   m.conditions.push_back(std::move(discovery_condition));
+  {
+    // The topic with default QoS, as the raw readers make theirs (-a records it too: one
+    // participant's topics of one name must agree). The reader deep enough for every
+    // container's report between two takes (one instance: the type has no key).
+    const char* name = "rt/avs/writer_counts";
+    m.counts_topic = dds::Entity(runtime::check_dds(
+        dds_create_topic(m.participant.get(),
+                         msg::TypeSupport<msgs::avs_msgs::WriterCounts>::descriptor(), name,
+                         nullptr, nullptr),
+        std::string("create topic ") + name));
+    runtime::QosProfile profile;
+    profile.depth = 256;
+    runtime::Qos q(profile);
+    m.participant.apply_partition(q.get());
+    m.counts_reader = dds::Entity(runtime::check_dds(
+        dds_create_reader(m.participant.get(), m.counts_topic.get(), q.get(), nullptr),
+        std::string("create reader on ") + name));
+    // Its progress: the last value is what counts (KEEP_LAST 1).
+    const char* progress_name = "rt/avs/recorder_progress";
+    m.progress_topic = dds::Entity(runtime::check_dds(
+        dds_create_topic(m.participant.get(),
+                         msg::TypeSupport<msgs::avs_msgs::WriterCounts>::descriptor(),
+                         progress_name, nullptr, nullptr),
+        std::string("create topic ") + progress_name));
+    runtime::QosProfile progress_profile;
+    progress_profile.depth = 1;
+    runtime::Qos pq(progress_profile);
+    m.participant.apply_partition(pq.get());
+    // Not fatal: a recorder whose DDS permissions do not let it publish still records; only
+    // lockstep graphs cannot wait for it.
+    const dds_entity_t progress_writer =
+        dds_create_writer(m.participant.get(), m.progress_topic.get(), pq.get(), nullptr);
+    if (progress_writer > 0) {
+      m.progress_writer = dds::Entity(progress_writer);
+    } else {
+      std::fprintf(stderr,
+                   "avs bag record: WARNING: cannot publish %s (%s): lockstep graphs will not "
+                   "wait for this recorder and it may lose samples (it counts them)\n",
+                   progress_name, dds_strretcode(progress_writer));
+    }
+    dds::Entity counts_condition(
+        runtime::check_dds(dds_create_readcondition(m.counts_reader.get(), DDS_ANY_STATE),
+                           "/avs/writer_counts read condition"));
+    m.waitset->attach(counts_condition.get(), 1);
+    m.conditions.push_back(std::move(counts_condition));
+  }
 }
 
 Recorder::~Recorder() {
@@ -464,20 +708,7 @@ RecorderStatus Recorder::status() const {
   {
     std::lock_guard lock(m.topics_mutex);
     for (const auto& [name, t] : m.topics) {
-      TopicCounters c;
-      c.topic = t->ros_topic;
-      c.type = t->ros_type;
-      c.qos = t->requested_qos;
-      c.publishers = t->writers.size();
-      c.received = t->received;
-      c.written = t->written;
-      c.bytes = t->bytes;
-      c.dds_lost = t->dds_lost;
-      c.dds_rejected = t->dds_rejected;
-      c.queue_dropped = t->queue_dropped;
-      c.write_failed = t->write_failed;
-      c.incompatible_writers = t->incompatible;
-      c.skipped_because = t->skipped_because;
+      TopicCounters c = t->counters();
       s.received += c.received;
       s.written += c.written;
       s.bytes_received += c.bytes;
@@ -513,8 +744,12 @@ std::string format_record_report(const RecorderStatus& s) {
                   static_cast<unsigned long long>(t.lost()));
     out << line;
     if (t.lost() > 0) {
-      out << "  LOST on " << t.topic << ": " << t.dds_lost
-          << " reported lost by DDS (sample lost), " << t.dds_rejected
+      out << "  LOST on " << t.topic << ": ";
+      if (t.writers_reconciled > 0) {
+        out << t.missing << " of " << t.expected_in_window
+            << " never received (the writers' counts), ";
+      }
+      out << t.dds_lost << " reported lost by DDS (sample lost), " << t.dds_rejected
           << " rejected by DDS (sample rejected), " << t.queue_dropped
           << " dropped by the recorder (queue full)";
       if (t.write_failed > 0) {
@@ -528,6 +763,25 @@ std::string format_record_report(const RecorderStatus& s) {
           << "): their samples are not recorded\n";
     }
   }
+  std::string unreconciled;
+  std::size_t reconciled = 0, recorded = 0;
+  for (const auto& t : s.topics) {
+    if (!t.skipped_because.empty() || t.received == 0) continue;
+    ++recorded;
+    if (t.writers_reconciled > 0 && t.writers_unreconciled == 0) {
+      ++reconciled;
+    } else {
+      unreconciled += (unreconciled.empty() ? "" : ", ") + t.topic;
+    }
+  }
+  out << "reconciled with the writers' own counts: " << reconciled << " of " << recorded
+      << " topic(s)";
+  if (!unreconciled.empty()) {
+    out << "; not (writers without /avs/writer_counts, or seen too briefly; only what DDS "
+           "reports is counted lost there): "
+        << unreconciled;
+  }
+  out << "\n";
   out << "total: " << s.received << " received, " << s.written << " written, " << s.lost
       << " lost; queue peak " << s.queue_bytes_peak / 1e6 << " MB\n";
   for (const auto& f : s.files) out << "file: " << f.string() << "\n";

@@ -97,6 +97,25 @@ Status parse_message(std::span<const std::byte> content, std::uint64_t base,
 Decoder::Decoder(std::unique_ptr<Source> source, const ReaderOptions& options)
     : source_(std::move(source)), options_(options) {}
 
+Status Decoder::read_metadata(const MetadataIndex& index, Metadata& out) {
+  ByteBuffer scratch;
+  RecordView record;
+  const std::uint64_t size = source_->size();
+  const std::uint64_t limit = index.offset <= size && index.length <= size - index.offset
+                                  ? index.offset + index.length
+                                  : size;
+  if (Status s = read_record(index.offset, limit, scratch, record); !s.ok()) return s;
+  const std::string where = "Metadata record at " + at(index.offset);
+  if (record.opcode != static_cast<std::uint8_t>(Opcode::metadata)) {
+    return Status(StatusCode::malformed,
+                  where + ": the index points at a " + opcode_name(record.opcode) + " record");
+  }
+  Cursor c(record.content, index.offset + kRecordPrefixSize, where);
+  out.name = c.string("metadata name");
+  out.metadata = c.string_map("metadata");
+  return c.status();
+}
+
 Status Decoder::read_record(std::uint64_t offset, std::uint64_t limit, ByteBuffer& scratch,
                             RecordView& out) {
   if (offset > limit || limit - offset < kRecordPrefixSize) {

@@ -66,6 +66,9 @@ class Decoder {
                       const ReadOptions& options, const MessageCallback& on_message,
                       std::uint64_t& delivered, std::vector<SkippedChunk>& skipped);
 
+  /// The Metadata record a Metadata Index points at.
+  Status read_metadata(const MetadataIndex& index, Metadata& out);
+
   const std::map<SchemaId, Schema>& schemas() const { return schemas_; }
   const std::map<ChannelId, Channel>& channels() const { return channels_; }
 

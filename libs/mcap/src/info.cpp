@@ -54,6 +54,14 @@ Status read_bag_info(const std::filesystem::path& path, BagInfo& info) {
   }
   std::sort(info.topics.begin(), info.topics.end(),
             [](const TopicInfo& a, const TopicInfo& b) { return a.topic < b.topic; });
+  for (const MetadataIndex& index : summary.metadata_indexes) {
+    Metadata m;
+    if (Status s = reader.read_metadata(index, m); s.ok()) {
+      info.metadata.push_back(std::move(m));
+    } else {
+      info.metadata_problems.push_back(s.to_string());
+    }
+  }
   return {};
 }
 
@@ -131,6 +139,17 @@ std::string format_bag_info(const BagInfo& info) {
                   topic.message_encoding.c_str());
     out += line;
   }
+  for (const Metadata& m : info.metadata) {
+    // The recorder's own record in full (its loss figures); others (rosbag2's YAML) by name.
+    if (m.name != "avs_bag_record") {
+      out += "Metadata: " + m.name + " (" + std::to_string(m.metadata.size()) + " key(s))\n";
+      continue;
+    }
+    out += "Metadata: " + m.name + " (what the recorder received, lost and reconciled)\n";
+    for (const auto& [key, value] : m.metadata) out += "  " + key + ": " + value + "\n";
+  }
+  for (const std::string& problem : info.metadata_problems)
+    out += "Metadata: NOT readable: " + problem + "\n";
   return out;
 }
 

@@ -87,6 +87,11 @@ Status Reader::scan(ScanResult& result, bool allow_truncated, const MessageCallb
   return s;
 }
 
+Status Reader::read_metadata(const MetadataIndex& index, Metadata& out) {
+  if (!impl_) return Status(StatusCode::invalid_argument, "read_metadata: reader is not open");
+  return impl_->decoder->read_metadata(index, out);
+}
+
 Status Reader::read_messages(const MessageCallback& on_message, const ReadOptions& options,
                              ReadReport* report) {
   if (!impl_) return Status(StatusCode::invalid_argument, "read_messages: reader is not open");

@@ -22,8 +22,8 @@ namespace fs = std::filesystem;
 
 const std::vector<std::string> top_keys = {"args",  "namespace", "domain_id",
                                            "clock", "include",   "containers"};
-const std::vector<std::string> clock_keys = {"source", "mode", "real_time_factor", "master",
-                                             "duration_s"};
+const std::vector<std::string> clock_keys = {"source", "mode",       "real_time_factor",
+                                             "master", "duration_s", "wait_for_recorders"};
 
 /// Argument values handed to a file: from the command line (top-level file) or from the
 /// `args:` of an include entry.
@@ -34,7 +34,8 @@ struct GivenArgs {
 
 bool same_clock(const ClockSpec& a, const ClockSpec& b) {
   return a.source == b.source && a.mode == b.mode && a.real_time_factor == b.real_time_factor &&
-         a.master == b.master && a.duration_s == b.duration_s;
+         a.master == b.master && a.duration_s == b.duration_s &&
+         a.wait_for_recorders == b.wait_for_recorders;
 }
 
 /// The default text of an argument declaration (scalar, or a list written as "[a, b]").
@@ -134,6 +135,9 @@ std::optional<ClockSpec> read_clock(LoadState& state, const FileReader& reader,
       }
     } else if (e.key == "duration_s") {
       if (auto v = reader.number(e.value, what, 0.0, std::nullopt)) clock.duration_s = *v;
+    } else if (e.key == "wait_for_recorders") {
+      if (auto i = reader.choice(e.value, what, {"false", "true"}))
+        clock.wait_for_recorders = *i == 1;
     }
   }
   if (state.diags.count() != errors_before) return std::nullopt;

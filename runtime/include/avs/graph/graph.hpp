@@ -69,6 +69,10 @@ struct ClockSpec {
   double real_time_factor = 1.0;
   std::string master;                ///< container name; default: the first container
   std::optional<double> duration_s;  ///< stop the graph after this much (sim or wall) time
+  /// Lockstep: before time advances, a writer with a recorder (`avs bag record`) among its
+  /// matched readers waits until the recorder has acknowledged what it may otherwise overwrite,
+  /// so the recording is complete whatever the load (issue 20 section 6, docs/bag.md).
+  bool wait_for_recorders = true;
 };
 
 struct Graph {

@@ -7,10 +7,13 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <dds/dds.h>
@@ -47,6 +50,48 @@ struct EndpointQos {
   std::string describe() const;
 };
 
+/// The USER_DATA of a recorder's readers (`avs bag record`): writers of a lockstep graph wait
+/// for readers that carry it (runtime/src/recorder_acks.hpp).
+inline constexpr std::string_view kRecorderUserData = "avs.recorder;";
+
+/// One remote reader or writer, as DDS discovery (the DCPSPublication and DCPSSubscription
+/// built-in topics) shows it.
+struct DiscoveredEndpoint {
+  bool is_writer = true;
+  std::array<std::uint8_t, 16> key{};          ///< the endpoint's GUID
+  std::array<std::uint8_t, 16> participant{};  ///< its participant's GUID
+  std::string topic;                           ///< DDS name, e.g. "rt/chatter"
+  std::string type_name;                       ///< DDS type name
+  std::shared_ptr<const dds_qos_t> qos;        ///< a copy of its QoS (never null)
+};
+
+enum class EndpointKinds { writers, readers, both };
+
+/// Follows DDS discovery: every alive endpoint of other participants, Cyclone's own DCPS*
+/// topics left out (the one place `avs topic`, `avs node`, `avs graph live` and the recorder
+/// read discovery from).
+class EndpointDiscovery {
+ public:
+  using Key = std::pair<std::array<std::uint8_t, 16>, bool>;  ///< (GUID, is_writer)
+
+  explicit EndpointDiscovery(const Participant& participant,
+                             EndpointKinds kinds = EndpointKinds::both);
+  /// Takes what discovery learned since the last call: returns the endpoints that appeared;
+  /// those gone (disposed, their participant lost) leave endpoints().
+  std::vector<DiscoveredEndpoint> update();
+  const std::map<Key, DiscoveredEndpoint>& endpoints() const { return endpoints_; }
+  /// The DCPSPublication reader (attach a read condition to a waitset to wake on news);
+  /// 0 without writers.
+  dds_entity_t publication_reader() const { return publications_.get(); }
+
+ private:
+  void take(dds_entity_t reader, bool is_writer, std::vector<DiscoveredEndpoint>& appeared);
+
+  Entity publications_, subscriptions_;
+  std::array<std::uint8_t, 16> own_{};
+  std::map<Key, DiscoveredEndpoint> endpoints_;
+};
+
 /// One remote data writer, as seen on the DCPSPublication built-in topic.
 struct DiscoveredPublication {
   std::string topic;                   ///< DDS name, e.g. "rt/chatter"
@@ -62,11 +107,10 @@ class PublicationDiscovery {
   explicit PublicationDiscovery(const Participant& participant);
   std::vector<DiscoveredPublication> poll();
   /// The built-in reader (attach its status/read condition to a waitset to wake on news).
-  dds_entity_t reader() const { return reader_.get(); }
+  dds_entity_t reader() const { return discovery_.publication_reader(); }
 
  private:
-  Entity reader_;
-  std::array<std::uint8_t, 16> own_{};
+  EndpointDiscovery discovery_;
 };
 
 /// Totals of samples a reader knows it did not get (cumulative since creation).
@@ -78,8 +122,9 @@ struct ReaderLoss {
 /// A reader that hands out serialised samples (Cyclone serdata, one reference each).
 class RawReader {
  public:
+  /// `user_data`: the reader's USER_DATA QoS (e.g. kRecorderUserData); empty: none.
   RawReader(const Participant& participant, const msg::TypeEntry& type,
-            const std::string& dds_topic, const EndpointQos& qos);
+            const std::string& dds_topic, const EndpointQos& qos, std::string_view user_data = {});
 
   /// Takes up to `max` samples; for each valid one calls `fn(serdata, info)`. `fn` receives
   /// a serdata reference it owns (keep it, or release it with ddsi_serdata_unref). Returns

@@ -50,6 +50,12 @@ class Scheduler {
   /// lockstep or realtime mode; the container publishes /clock from it.
   void on_time_advanced(std::function<void(Time)> fn) { time_advanced_ = std::move(fn); }
 
+  /// Lockstep: called (outside the lock, on a lane thread, no lane running a callback) each
+  /// time every lane is idle and time is about to advance; time advances once it returns,
+  /// unless a callback was queued meanwhile (that runs first). The container waits there for
+  /// recorders' acknowledgements.
+  void before_time_advance(std::function<void()> fn) { before_advance_ = std::move(fn); }
+
   /// Thread body: runs `lane`'s callbacks and timers until stop().
   void run_lane(int lane);
   void stop();
@@ -85,6 +91,7 @@ class Scheduler {
   std::optional<Time> end_;
   bool stopping_ = false;
   std::function<void(Time)> time_advanced_;
+  std::function<void()> before_advance_;
 };
 
 }  // namespace avs::runtime

@@ -5,9 +5,13 @@
 // holds Cyclone's serdata references, so a sample is never copied before it reaches the
 // chunk buffer) and a writer thread (queue -> avs::mcap::Writer, whose own thread compresses
 // and writes chunks). Every sample the recorder knows it did not store is counted, per
-// topic and per cause: DDS sample-lost, DDS sample-rejected, its own queue overflow.
+// topic and per cause: DDS sample-lost, DDS sample-rejected, its own queue overflow; and
+// what the recorder received from each writer is reconciled with the writer's own count
+// (/avs/writer_counts, published by every avs container), which also finds the samples DDS
+// never reports lost (issue 20 section 6).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -58,7 +62,22 @@ struct TopicCounters {
   std::uint64_t write_failed = 0;
   std::uint32_t incompatible_writers = 0;  ///< writers not matched (QoS): not recorded at all
   std::string skipped_because;             ///< non-empty: the topic is not recorded
-  std::uint64_t lost() const { return dds_lost + dds_rejected + queue_dropped + write_failed; }
+  /// Reconciliation with the writers' own counts (/avs/writer_counts, receipt_ledger.hpp):
+  /// writers with a window, writers without (not avs components, or seen too briefly).
+  std::uint32_t writers_reconciled = 0;
+  std::uint32_t writers_unreconciled = 0;
+  std::uint64_t expected_in_window = 0;  ///< written by reconciled writers inside their windows
+  std::uint64_t missing = 0;  ///< of those, never received (whether DDS reported them or not)
+  /// Samples that never reached the recorder: the writers' count where every writer has one
+  /// (DDS's own statuses miss overwritten samples and count rejected ones that were resent);
+  /// DDS's sample-lost and sample-rejected counts where none has; the larger of the two when
+  /// some have.
+  std::uint64_t not_received() const {
+    if (writers_reconciled == 0) return dds_lost + dds_rejected;
+    if (writers_unreconciled == 0) return missing;
+    return std::max(missing, dds_lost + dds_rejected);
+  }
+  std::uint64_t lost() const { return not_received() + queue_dropped + write_failed; }
 };
 
 struct RecorderStatus {

@@ -37,6 +37,11 @@ struct BagInfo {
   bool from_summary = false;      ///< false: rebuilt by a linear scan
   bool truncated = false;         ///< scan stopped at an incomplete tail (repair advised)
   std::uint64_t truncated_at = 0;
+  /// The Metadata records (e.g. "rosbag2", and "avs_bag_record": what `avs bag record`
+  /// received, lost and reconciled per topic, docs/bag.md "Loss accounting").
+  std::vector<Metadata> metadata;
+  /// Metadata records that could not be read (the reason each).
+  std::vector<std::string> metadata_problems;
 };
 
 Status read_bag_info(const std::filesystem::path& path, BagInfo& info);

@@ -120,6 +120,9 @@ class Reader {
   Status scan(ScanResult& result, bool allow_truncated = false,
               const MessageCallback& on_message = {});
 
+  /// The Metadata record of one of summary().metadata_indexes (read_summary() or scan() first).
+  Status read_metadata(const MetadataIndex& index, Metadata& out);
+
   /// Messages in log-time order (ties: file order), through the chunk indexes; falls back
   /// to a linear scan when the summary is missing (see ReadOptions).
   Status read_messages(const MessageCallback& on_message, const ReadOptions& options = {},
