@@ -18,6 +18,7 @@
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/error.hpp"
+#include "avs/runtime/raw_topic.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
 #include "diagnostic_msgs.h"
@@ -28,9 +29,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 /// Hex of a GUID: the 12-byte prefix names a participant, all 16 bytes an endpoint.
-std::string guid_text(const dds_guid_t& g, int bytes = 12) {
+std::string guid_text(const std::uint8_t* g, int bytes = 12) {
   std::ostringstream s;
-  for (int i = 0; i < bytes; ++i) s << std::hex << std::setw(2) << std::setfill('0') << int(g.v[i]);
+  for (int i = 0; i < bytes; ++i) s << std::hex << std::setw(2) << std::setfill('0') << int(g[i]);
   return s.str();
 }
 
@@ -156,17 +157,7 @@ int run_graph_view(const Options& o) {
   const int domain = o.domain;
   runtime::dds::Participant participant(static_cast<dds_domainid_t>(domain),
                                         environment_partition());
-  const std::string self = [&] {
-    dds_guid_t g;
-    dds_get_guid(participant.get(), &g);
-    return guid_text(g);
-  }();
-  runtime::dds::Entity pubs(runtime::check_dds(
-      dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
-      "DCPSPublication reader"));
-  runtime::dds::Entity subs(runtime::check_dds(
-      dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr),
-      "DCPSSubscription reader"));
+  runtime::dds::EndpointDiscovery discovery(participant);
 
   // /diagnostics names the participants (container/component) and carries their health.
   const msg::TypeEntry* diag_type = msg::find_type("diagnostic_msgs::msg::dds_::DiagnosticArray_");
@@ -197,25 +188,13 @@ int run_graph_view(const Options& o) {
   std::uint64_t diag_samples = 0;  // /diagnostics is read above, not by a counter
   Clock::time_point rate_start{};
 
-  auto take_endpoints = [&](dds_entity_t reader, bool is_pub) {
-    void* samples[64] = {};
-    dds_sample_info_t infos[64];
-    int n;
-    while ((n = dds_take(reader, samples, infos, 64, 64)) > 0) {
-      for (int i = 0; i < n; ++i) {
-        const auto* ep = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
-        const std::string key = guid_text(ep->key, 16) + (is_pub ? "w" : "r");
-        if (infos[i].instance_state != DDS_IST_ALIVE) {
-          endpoints.erase(key);
-          continue;
-        }
-        if (!infos[i].valid_data) continue;
-        Endpoint e{guid_text(ep->participant_key), ep->topic_name, ep->type_name,
-                   read_qos(ep->qos)};
-        if (e.participant == self) continue;
-        endpoints[key] = std::move(e);
-      }
-      dds_return_loan(reader, samples, n);
+  // The endpoints DDS discovery shows now (those gone dropped), keyed by GUID text + w/r.
+  auto take_endpoints = [&] {
+    discovery.update();
+    endpoints.clear();
+    for (const auto& [key, ep] : discovery.endpoints()) {
+      endpoints[guid_text(ep.key.data(), 16) + (ep.is_writer ? "w" : "r")] = Endpoint{
+          guid_text(ep.participant.data()), ep.topic, ep.type_name, read_qos(ep.qos.get())};
     }
   };
   auto take_diagnostics = [&] {
@@ -241,7 +220,7 @@ int run_graph_view(const Options& o) {
           health[name] = std::move(h);
         }
         if (w != nullptr) {
-          if (!container.empty()) participant_name[guid_text(w->participant_key)] = container;
+          if (!container.empty()) participant_name[guid_text(w->participant_key.v)] = container;
           dds_builtintopic_free_endpoint(w);
         }
       }
@@ -255,8 +234,7 @@ int run_graph_view(const Options& o) {
       start + std::chrono::milliseconds(static_cast<int>(1000 * std::max(1.2, o.duration_s / 2)));
   const auto end = start + std::chrono::milliseconds(static_cast<int>(1000 * o.duration_s));
   while (Clock::now() < end) {
-    take_endpoints(pubs.get(), true);
-    take_endpoints(subs.get(), false);
+    take_endpoints();
     take_diagnostics();
     if (!o.no_rates && rate_start == Clock::time_point{} && Clock::now() >= discover_until) {
       for (const auto& [key, e] : endpoints) {

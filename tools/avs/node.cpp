@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "avs/runtime/parameters.hpp"
+#include "avs/runtime/raw_topic.hpp"
 #include "avs/runtime/ros_discovery.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
@@ -41,25 +42,11 @@ struct NodeEndpoint {
 
 /// Every remote reader and writer DDS discovery shows (built-in topics), by GUID.
 std::map<runtime::Gid, NodeEndpoint> endpoints(const runtime::dds::Participant& participant) {
+  runtime::dds::EndpointDiscovery discovery(participant);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  discovery.update();
   std::map<runtime::Gid, NodeEndpoint> out;
-  for (const auto builtin :
-       {DDS_BUILTIN_TOPIC_DCPSPUBLICATION, DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION}) {
-    runtime::dds::Entity reader(runtime::check_dds(
-        dds_create_reader(participant.get(), builtin, nullptr, nullptr), "read DDS discovery"));
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
-    void* samples[1024] = {};
-    dds_sample_info_t infos[1024];
-    const int n =
-        runtime::check_dds(dds_read(reader.get(), samples, infos, 1024, 1024), "read discovery");
-    for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data) continue;
-      const auto* ep = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
-      runtime::Gid gid;
-      std::copy(std::begin(ep->key.v), std::end(ep->key.v), gid.begin());
-      out[gid] = {ep->topic_name, ep->type_name};
-    }
-    if (n > 0) dds_return_loan(reader.get(), samples, n);
-  }
+  for (const auto& [key, e] : discovery.endpoints()) out[e.key] = {e.topic, e.type_name};
   return out;
 }
 

@@ -18,6 +18,7 @@
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/parameters.hpp"
+#include "avs/runtime/raw_topic.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
@@ -73,40 +74,18 @@ void sleep_unless_interrupted(std::chrono::milliseconds wait) {
   }
 }
 
-/// Reads the built-in publication/subscription topics for `wait`, skipping our own.
+/// Reads DDS discovery for `wait`: every other participant's endpoints, by topic.
 std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& participant,
                                           std::chrono::milliseconds wait) {
-  runtime::dds::Entity pubs(runtime::check_dds(
-      dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr),
-      "read DCPSPublication"));
-  runtime::dds::Entity subs(runtime::check_dds(
-      dds_create_reader(participant.get(), DDS_BUILTIN_TOPIC_DCPSSUBSCRIPTION, nullptr, nullptr),
-      "read DCPSSubscription"));
+  runtime::dds::EndpointDiscovery discovery(participant);
   sleep_unless_interrupted(wait);
-  dds_guid_t own{};
-  runtime::check_dds(dds_get_guid(participant.get(), &own), "participant guid");
-
+  discovery.update();
   std::map<std::string, TopicInfo> topics;
-  for (int kind = 0; kind < 2; ++kind) {
-    const dds_entity_t reader = kind == 0 ? pubs.get() : subs.get();
-    void* samples[256] = {};
-    dds_sample_info_t infos[256];
-    const int n = runtime::check_dds(dds_read(reader, samples, infos, 256, 256), "read discovery");
-    for (int i = 0; i < n; ++i) {
-      if (!infos[i].valid_data || infos[i].instance_state != DDS_IST_ALIVE) continue;
-      const auto* ep = static_cast<const dds_builtintopic_endpoint_t*>(samples[i]);
-      if (std::equal(std::begin(ep->participant_key.v), std::end(ep->participant_key.v),
-                     std::begin(own.v))) {
-        continue;
-      }
-      const std::string topic = ep->topic_name;
-      if (topic.rfind("DCPS", 0) == 0) continue;
-      TopicInfo& info = topics[topic];
-      info.type_name = ep->type_name;
-      (kind == 0 ? info.publishers : info.subscribers)
-          .push_back({ep->type_name, describe_qos(ep->qos)});
-    }
-    dds_return_loan(reader, samples, n);
+  for (const auto& [key, e] : discovery.endpoints()) {
+    TopicInfo& info = topics[e.topic];
+    info.type_name = e.type_name;
+    (e.is_writer ? info.publishers : info.subscribers)
+        .push_back({e.type_name, describe_qos(e.qos.get())});
   }
   return topics;
 }
