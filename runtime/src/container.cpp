@@ -38,6 +38,7 @@ struct TopicEntry {
   /// What the writer has written, for /avs/writer_counts (recorders reconcile against it).
   WriterTally tally;
   std::uint32_t history_depth = 0;  ///< the writer's KEEP_LAST depth
+  bool reliable = true;
   /// The writer keeps its last samples for readers that match later (transient local):
   /// they must reach the DDS writer even when no remote reader is matched yet.
   bool latched = false;
@@ -367,6 +368,7 @@ TopicEntry& ComponentHost::add_publication(const std::string& dds_name, const ms
     topic.writer = std::make_unique<dds::Writer>(container_.participant, *topic.topic, qos);
     topic.latched = qos.durability == Durability::transient_local;
     topic.history_depth = qos.depth;
+    topic.reliable = qos.reliability == Reliability::reliable;
   }
   published.push_back(&topic);
   return topic;
@@ -715,17 +717,28 @@ int Container::run() {
     std::vector<RecorderAcks::Watched> watched;
     for (const TopicEntry* t : published) {
       entries.push_back({t->writer.get(), from_dds_topic_name(t->dds_name), &t->tally});
-      watched.push_back({t->writer.get(), &t->tally, t->history_depth});
+      watched.push_back({t->writer.get(), &t->tally, t->history_depth, t->reliable});
     }
     c.writer_counts =
         std::make_unique<WriterCountsPublisher>(c.participant, spec_.name, std::move(entries));
-    scheduler.add_timer(0, std::chrono::milliseconds(100),
-                        [&c, &scheduler] { c.writer_counts->publish(scheduler.now()); });
+    scheduler.add_timer(0, std::chrono::milliseconds(100), [&c, &scheduler] {
+      try {
+        c.writer_counts->publish(scheduler.now());
+      } catch (const std::exception& e) {
+        c.log.warn("/avs/writer_counts not published: ", e.what());
+      }
+    });
     // Lockstep time is the graph's own: it waits for recorders rather than outrun them.
     if (mode == TimeMode::sim_lockstep && graph_.clock.wait_for_recorders) {
       c.recorder_acks = std::make_unique<RecorderAcks>(c.participant, std::move(watched), c.log,
                                                        std::chrono::seconds(2));
-      scheduler.before_time_advance([&c] { c.recorder_acks->wait(); });
+      scheduler.before_time_advance([&c, &scheduler] {
+        try {
+          c.recorder_acks->wait([&scheduler] { return scheduler.stopped(); });
+        } catch (const std::exception& e) {
+          c.log.warn("waiting for recorders: ", e.what());
+        }
+      });
     }
   }
 

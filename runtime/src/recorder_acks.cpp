@@ -88,7 +88,8 @@ bool RecorderAcks::caught_up(const Gid& gid, std::int64_t source_ns) {
   constexpr std::size_t kMax = 64;
   dds_instance_handle_t handles[kMax];
   const dds_return_t n = dds_get_matched_publications(progress_reader_.get(), handles, kMax);
-  const std::set<dds_instance_handle_t> live(handles, handles + std::max<dds_return_t>(0, n));
+  const std::set<dds_instance_handle_t> live(
+      handles, handles + std::clamp<dds_return_t>(n, 0, static_cast<dds_return_t>(kMax)));
   bool any = false;
   for (const auto& [key, newest] : newest_) {
     if (key.second != gid || live.count(key.first) == 0) continue;
@@ -98,9 +99,12 @@ bool RecorderAcks::caught_up(const Gid& gid, std::int64_t source_ns) {
   return any;
 }
 
-void RecorderAcks::wait() {
+void RecorderAcks::wait(const std::function<bool()>& stop_requested) {
   take_progress();
+  // One deadline for the whole step: a hung recorder costs `timeout` per step, not per writer.
+  const auto deadline = std::chrono::steady_clock::now() + timeout_;
   for (Writer& w : writers_) {
+    if (!w.watched.reliable) continue;
     const dds::Writer& writer = *w.watched.writer;
     dds_publication_matched_status_t status{};
     if (dds_get_publication_matched_status(writer.get(), &status) < 0) continue;
@@ -123,9 +127,8 @@ void RecorderAcks::wait() {
       w.caught_up = cut.published;
       continue;
     }
-    const auto deadline = std::chrono::steady_clock::now() + timeout_;
     bool done = false;
-    while (!done) {
+    while (!done && !stop_requested()) {
       const auto left = deadline - std::chrono::steady_clock::now();
       if (left <= Duration::zero()) break;
       dds_attach_t triggered[2];
@@ -136,7 +139,7 @@ void RecorderAcks::wait() {
       done = caught_up(w.gid, cut.last_source_time_ns);
     }
     w.caught_up = cut.published;  // caught up, or given up on: time goes on
-    if (!done) {
+    if (!done && !stop_requested()) {
       ++timeouts_;
       log_.warn("a recorder of ", writer.topic_name(), " did not catch up within ",
                 static_cast<double>(timeout_.count()) * 1e-9,

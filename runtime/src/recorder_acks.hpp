@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <utility>
 #include <vector>
@@ -32,12 +33,14 @@ class RecorderAcks {
     const dds::Writer* writer;
     const WriterTally* tally;
     std::uint32_t history_depth;
+    bool reliable;  ///< best-effort writers are not waited for: a lost sample never arrives
   };
 
   RecorderAcks(const dds::Participant& participant, std::vector<Watched> writers, const Logger& log,
                Duration timeout);
-  /// Before a lockstep step: waits where a recorder would otherwise lose samples.
-  void wait();
+  /// Before a lockstep step: waits where a recorder would otherwise lose samples, at most
+  /// `timeout` in all, and not once `stop_requested` says so.
+  void wait(const std::function<bool()>& stop_requested);
   /// Waits that ran out of time (the recorder then loses samples, and reports them).
   std::uint64_t timeouts() const { return timeouts_; }
 

@@ -209,6 +209,9 @@ void Scheduler::wait_locked(std::unique_lock<std::mutex>& lock, int lane_index) 
         before_advance_();
         lock.lock();
         lane.idle = true;
+        // A callback queued meanwhile (this lane's too) runs first, without a wait; a stop
+        // requested meanwhile ends the run where it is.
+        if (!all_idle_locked() || stopping_) break;
       }
       if (all_idle_locked() && !timers_.empty()) {
         // Every lane is idle and nothing is due: jump to the earliest deadline.

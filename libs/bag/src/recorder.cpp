@@ -144,6 +144,8 @@ struct Recorder::Impl {
   /// for it (runtime/src/recorder_acks.hpp); sent when it changed.
   dds::Entity progress_topic, progress_writer;
   std::map<std::pair<RecordedTopic*, WriterGid>, std::uint64_t> progress_sent;
+  std::chrono::steady_clock::time_point progress_sent_at{};
+  bool progress_failed = false;
 
   mutable std::mutex topics_mutex;
   std::map<std::string, std::unique_ptr<RecordedTopic>> topics;  // by DDS name
@@ -224,9 +226,11 @@ struct Recorder::Impl {
         q.transient_local = p.qos.transient_local;
         q.keep_all = true;
         t->requested_qos = q.describe();
-        // Marked as a recorder's: a lockstep graph's writers wait for its acknowledgements.
-        t->reader = std::make_unique<dds::RawReader>(participant, *type, p.topic, q,
-                                                     dds::kRecorderUserData);
+        // Marked as a recorder's, a lockstep graph's writers wait for it: only when it can
+        // tell them what it has (its progress writer exists), or they would wait in vain.
+        t->reader = std::make_unique<dds::RawReader>(
+            participant, *type, p.topic, q,
+            progress_writer ? dds::kRecorderUserData : std::string_view{});
         dds::Entity condition(
             runtime::check_dds(dds_create_readcondition(t->reader->get(), DDS_ANY_STATE),
                                "read condition on " + p.topic));
@@ -249,6 +253,9 @@ struct Recorder::Impl {
     const std::uint64_t size = ddsi_serdata_size(data);
     t.received.fetch_add(1, std::memory_order_relaxed);
     t.bytes.fetch_add(size, std::memory_order_relaxed);
+    // Received, whether or not the queue has room: a drop is counted as queue_dropped, not
+    // again as missing, and a lockstep graph is told it arrived.
+    note_receipt(t, info);
     std::lock_guard lock(queue_mutex);
     if (queued_bytes.load(std::memory_order_relaxed) + size > options.queue_bytes &&
         !queue.empty()) {
@@ -258,7 +265,6 @@ struct Recorder::Impl {
     }
     const std::uint64_t publish =
         info.source_timestamp > 0 ? static_cast<std::uint64_t>(info.source_timestamp) : now;
-    note_receipt(t, info);
     queue.push_back({&t, data, size, now, publish});
     const std::uint64_t q = queued_bytes.fetch_add(size, std::memory_order_relaxed) + size;
     if (q > queued_peak.load(std::memory_order_relaxed))
@@ -299,7 +305,13 @@ struct Recorder::Impl {
           const auto* counts = static_cast<const avs_msgs_msg_dds__WriterCounts_*>(samples[i]);
           for (std::uint32_t k = 0; k < counts->writers._length; ++k) {
             const auto& w = counts->writers._buffer[k];
-            auto it = topics.find(runtime::to_dds_topic_name(runtime::get_string(w.topic)));
+            std::string dds_name;
+            try {
+              dds_name = runtime::to_dds_topic_name(runtime::get_string(w.topic));
+            } catch (const std::exception&) {
+              continue;  // not a topic name (not from an avs container): nothing to reconcile
+            }
+            auto it = topics.find(dds_name);
             if (it == topics.end() || !it->second->reader) continue;
             WriterGid gid;
             std::copy(std::begin(w.writer_gid), std::end(w.writer_gid), gid.begin());
@@ -313,9 +325,14 @@ struct Recorder::Impl {
     }
   }
 
-  /// Tells lockstep graphs what it has received, when that changed since the last time.
+  /// Tells lockstep graphs what it has received from every writer: the whole state each time
+  /// (a KEEP_LAST 1 update overwritten before it was resent, or sent before a container's
+  /// reader matched, must not leave a writer waiting), when something changed and every
+  /// 100 ms.
   void publish_progress() {
     if (!progress_writer) return;
+    const auto now = std::chrono::steady_clock::now();
+    bool changed = false;
     struct Item {
       std::string topic;
       WriterGid gid;
@@ -329,13 +346,15 @@ struct Recorder::Impl {
         std::lock_guard ledger_lock(t->ledger_mutex);
         for (const auto& [gid, p] : t->ledger.progress()) {
           std::uint64_t& sent = progress_sent[{t.get(), gid}];
-          if (sent == p.received) continue;
+          if (sent != p.received) changed = true;
           sent = p.received;
           items.push_back({t->ros_topic, gid, p});
         }
       }
     }
-    if (items.empty()) return;
+    if (items.empty() || (!changed && now - progress_sent_at < std::chrono::milliseconds(100)))
+      return;
+    progress_sent_at = now;
     auto sample = runtime::make_sample<msgs::avs_msgs::WriterCounts>();
     runtime::set_string(sample->header.frame_id, "avs bag record");
     runtime::resize_sequence(sample->writers, static_cast<std::uint32_t>(items.size()));
@@ -346,8 +365,13 @@ struct Recorder::Impl {
       out.samples = items[i].p.received;
       out.last_source_timestamp_ns = items[i].p.newest_source_time_ns;
     }
-    runtime::check_dds(dds_write(progress_writer.get(), sample.get()),
-                       "write /avs/recorder_progress");
+    if (const dds_return_t rc = dds_write(progress_writer.get(), sample.get()); rc < 0) {
+      if (!progress_failed) {
+        std::fprintf(stderr, "avs bag record: WARNING: writing /avs/recorder_progress: %s\n",
+                     dds_strretcode(rc));
+      }
+      progress_failed = true;  // said once; the recording goes on
+    }
   }
 
   /// Reports received so far, per (topic, writer): to wait for fresh ones when stopping.
