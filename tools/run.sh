@@ -111,7 +111,10 @@ case "${1:-}" in
       suites+='|Cia402|AxisPlant|RegisterMap|Safety|FaultLatch|LinkBudget|SimulatedDrive|ModbusFrame'
       suites+='|RegisterMapYaml|AmplifierServerTest|DriveClientTest|DriveClientConfigCheck'
       suites+='|SoftLimitEnvelopeTest|Corruptions'
-      exec ctest --output-on-failure -j "$JOBS" --timeout 1800 -R "^($suites)[./]" "$@"
+      # The two closed-loop recordings (3 s of the lockstep closed loop each) take more than their
+      # 300 s under TSan: left out (docs/reliability.md "Sanitizers").
+      exec ctest --output-on-failure -j "$JOBS" --timeout 1800 -R "^($suites)[./]" \
+        -E 'BagRecord\.(ReportedLossEqualsTheGaps|ALockstepGraphWaitsForItsRecorder)' "$@"
     fi
     build "$BUILD_DIR"
     cd "$BUILD_DIR"
