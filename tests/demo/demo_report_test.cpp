@@ -17,6 +17,7 @@
 
 #include "avs/report/run_data.hpp"
 #include "avs/report/summary.hpp"
+#include "avs/report/table.hpp"
 #include "avs_program.hpp"
 
 namespace fs = std::filesystem;
@@ -84,6 +85,17 @@ TEST(Demo, ShortRunMakesAReportFromItsOwnData) {
   if (!std::isnan(s.position_error_mm_rms)) {
     EXPECT_NEAR(json_number(json, "position_error_mm_rms"), s.position_error_mm_rms, 1e-6);
   }
+  // The wall clock beside the simulated one: every row has it, and the table says the run's
+  // real-time factor (whatever it is on this machine: only that it is measured).
+  for (const auto& row : run.frames) ASSERT_TRUE(row.wall_s.has_value()) << row.t_s;
+  EXPECT_GT(s.real_time_factor, 0.0);
+  EXPECT_NE(output.find("real-time factor " + avs::report::format_figure(s.real_time_factor)),
+            std::string::npos)
+      << output;
+  EXPECT_NE(output.find("verdict"), std::string::npos) << output;
+  // Figure 14 spread over the run: snapshots every 0.25 s of simulated time once matching runs.
+  ASSERT_GE(run.clouds.size(), 2U) << output;
+  EXPECT_GE(run.clouds.back().t_s - run.clouds.front().t_s, 0.2);
   // The printed table carries the same figure.
   std::ostringstream rate;
   rate << std::lround(s.depth_rate_hz);

@@ -98,7 +98,7 @@ TEST(Report, MakesEveryFigureWithDataAndAPageThatShowsThem) {
   const std::set<std::string> expected{
       "fig8_centroid_error.png",   "fig9_depth.png",   "fig10_centroid_trajectory.png",
       "fig13_points_and_time.png", "fig14_clouds.png", "fig15_position.png",
-      "fig16_quaternion.png"};
+      "fig16_quaternion.png",      "pose_error.png"};
   std::set<std::string> made;
   for (const Plot& plot : report.plots.made) made.insert(plot.png);
   EXPECT_EQ(made, expected);
@@ -128,6 +128,12 @@ TEST(Report, MakesEveryFigureWithDataAndAPageThatShowsThem) {
   // The page carries our numbers from this run, beside the paper's.
   EXPECT_NE(html.find(format_figure(report.summary.position_error_mm_rms)), std::string::npos);
   EXPECT_NE(html.find("<td class=\"num\">148</td>"), std::string::npos);
+  EXPECT_NE(html.find("real-time factor 0.2"), std::string::npos);
+  EXPECT_NE(html.find("<th>verdict</th>"), std::string::npos);
+  // Fig. 10(b): tick steps chosen for the data's span (gnuplot's own crowd the 3-D panel).
+  const std::string fig10 = read_text(tmp.path() / "gnuplot/fig10_centroid_trajectory.gp");
+  // X spans 0.2 m and Y 0.1 m: at most 4 ticks are steps of 0.1 and 0.05.
+  EXPECT_NE(fig10.find("set xtics 0.1\nset ytics 0.05 offset"), std::string::npos) << fig10;
   const std::string json = read_text(report.summary_json);
   EXPECT_NE(json.find("\"scenario\": \"demo\""), std::string::npos);
   EXPECT_NE(json.find("\"flips\": 4"), std::string::npos) << json;
@@ -188,7 +194,7 @@ TEST(Report, MalformedRunGivesFileLineOnStderr) {
   std::ofstream(tmp.path() / kFramesFile, std::ios::app) << "1,2,3\n";
   std::ostringstream out, err;
   EXPECT_EQ(report_main(tmp.path(), out, err), 1);
-  EXPECT_NE(err.str().find("frames.csv:1002: expected 28 fields"), std::string::npos) << err.str();
+  EXPECT_NE(err.str().find("frames.csv:1002: expected 29 fields"), std::string::npos) << err.str();
 }
 
 TEST(Tables, ComparisonTableHasThePapersFiguresAndOurs) {
@@ -209,11 +215,66 @@ TEST(Tables, ComparisonTableHasThePapersFiguresAndOurs) {
     EXPECT_NO_THROW((void)summary_value(s, figure.key)) << figure.key;
   }
   const std::string markdown = format_comparison_markdown("cube", s);
-  EXPECT_NE(markdown.find("| initial alignment | 93.98 | 93.5 | ms | 7.2.2 |"), std::string::npos)
+  EXPECT_EQ(
+      markdown.rfind("| figure | statistic | clock | paper | ours | unit | verdict | section |", 0),
+      0U)
+      << markdown;
+  EXPECT_NE(
+      markdown.find(
+          "| initial alignment | first | wall | 93.98 | 93.5 | ms | pass (< 93.98) | 7.2.2 |"),
+      std::string::npos)
+      << markdown;
+  // 490.25 Hz against the paper's 487: a pass within 1 % (>= 482.1).
+  EXPECT_NE(markdown.find("| ICP rate | mean rate | sim | 487 | 490.2 | Hz | pass (>= 482.1) |"),
+            std::string::npos)
       << markdown;
   const std::string json = experiments_json({{"ken", s}, {"cube", s}});
   EXPECT_EQ(json.rfind("{\"ken\": {\"scenario\": \"ken\"", 0), 0U) << json;
   EXPECT_NE(json.find(", \"cube\": {"), std::string::npos) << json;
+}
+
+TEST(Tables, VerdictsAgainstThePapersLimits) {
+  EXPECT_EQ(verdict(below(2), 1.85), "pass (< 2)");
+  EXPECT_EQ(verdict(below(1.5), 2.717), "FAIL (< 1.5)");
+  EXPECT_EQ(verdict(below(1.5), 1.5), "FAIL (< 1.5)");  // "less than" is strict
+  EXPECT_EQ(verdict(rate_of(500), 499.0), "pass (>= 495)");
+  EXPECT_EQ(verdict(rate_of(500), 492.0), "FAIL (>= 495)");
+  EXPECT_EQ(verdict(at_least(1), 1.0), "pass (>= 1)");
+  EXPECT_EQ(verdict(below(2), kUndefined), "-");
+  EXPECT_EQ(verdict(PaperLimit{}, 3.0), "");
+
+  // In the table: the demo's pair-time row fails when the 99th percentile is over 2 ms, and
+  // a row without a paper limit says "-".
+  Summary s;
+  s.depth_rate_hz = 500;
+  s.decode_ms_p99 = 2.4;
+  s.decode_ms_median = 1.1;
+  const auto rows = comparison_rows("demo", s);
+  const auto row = [&](const std::string& key) {
+    for (const ComparisonRow& r : rows) {
+      if (r.key == key) return r;
+    }
+    ADD_FAILURE() << key;
+    return ComparisonRow{};
+  };
+  EXPECT_EQ(row("decode_ms_p99").verdict, "FAIL (< 2)");
+  EXPECT_EQ(row("decode_ms_p99").statistic, "p99");
+  EXPECT_EQ(row("decode_ms_p99").clock, "wall");
+  EXPECT_EQ(row("decode_ms_median").verdict, "");
+  EXPECT_EQ(row("decode_ms_median").paper, "about 1.5 (GPU)");
+  EXPECT_EQ(row("depth_rate_hz").verdict, "pass (>= 495)");
+  EXPECT_EQ(row("depth_rate_hz").clock, "sim");
+  const std::string text = format_comparison_table("demo", s);
+  EXPECT_NE(text.find("FAIL (< 2)"), std::string::npos) << text;
+
+  s.duration_s = 3.0;
+  s.wall_duration_s = 15.0;
+  s.real_time_factor = 0.2;
+  const std::string clocks = format_run_clocks(s);
+  EXPECT_NE(clocks.find("3 s of simulated time in 15 s of wall-clock time (real-time factor 0.2)"),
+            std::string::npos)
+      << clocks;
+  EXPECT_NE(format_run_clocks(Summary{}).find("real-time factor unknown"), std::string::npos);
 }
 
 TEST(Tables, TextTableAlignsColumns) {

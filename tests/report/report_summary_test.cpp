@@ -201,6 +201,47 @@ TEST(Summary, RunWithoutMatchingHasNoPoseFigures) {
   EXPECT_NE(json.find("\"depth_rate_hz\": 500"), std::string::npos) << json;
 }
 
+TEST(Summary, RealTimeFactorFromTheWallClockBesideTheSimulatedOne) {
+  SyntheticOptions o;
+  o.wall_per_sim = 4.0;
+  const Summary s = compute_summary(make_frames(o), Symmetry::none());
+  EXPECT_NEAR(s.duration_s, 999 * 0.002, 1e-9);
+  EXPECT_NEAR(s.wall_duration_s, 4.0 * 999 * 0.002, 1e-9);
+  EXPECT_NEAR(s.real_time_factor, 0.25, 1e-12);
+  // A run folder from before wall_s: the factor is unknown, never made up.
+  std::vector<FrameRow> old = make_frames({});
+  for (FrameRow& row : old) row.wall_s.reset();
+  const Summary unknown = compute_summary(old, Symmetry::none());
+  EXPECT_TRUE(std::isnan(unknown.real_time_factor));
+  EXPECT_TRUE(std::isnan(unknown.wall_duration_s));
+}
+
+TEST(Summary, EveryFieldSaysItsStatisticAndClock) {
+  for (const SummaryField& field : summary_fields()) {
+    EXPECT_NE(std::string(field.statistic), "") << field.key;
+    const std::string key = field.key;
+    // Processing times are wall-clock, rates per simulated second, errors neither.
+    if (key.find("_ms_") != std::string::npos || key == "init_ms") {
+      EXPECT_EQ(field.clock, FigureClock::wall) << key;
+    }
+    if (key.ends_with("_hz")) {
+      EXPECT_EQ(field.clock, FigureClock::sim) << key;
+    }
+    if (key.find("error") != std::string::npos) {
+      EXPECT_EQ(field.clock, FigureClock::none) << key;
+    }
+    if (key.ends_with("_rms")) {
+      EXPECT_EQ(std::string(field.statistic), "RMS") << key;
+    }
+    if (key.ends_with("_p99")) {
+      EXPECT_EQ(std::string(field.statistic), "p99") << key;
+    }
+    if (key.ends_with("_median")) {
+      EXPECT_EQ(std::string(field.statistic), "median") << key;
+    }
+  }
+}
+
 TEST(Summary, EveryFieldIsInTheJson) {
   const Summary s = compute_summary(make_frames({}), Symmetry::none());
   const std::string json = to_json(s, "ken");

@@ -26,6 +26,7 @@ struct SyntheticOptions {
   std::vector<int> flip_frames{200, 201, 202, 640};  ///< meas rotated 180 deg about body Y
   bool with_poses = true;
   bool with_centroid = true;
+  double wall_per_sim = 5.0;  ///< wall-clock seconds per simulated second (real-time factor 0.2)
 };
 
 inline std::vector<FrameRow> make_frames(const SyntheticOptions& o) {
@@ -46,6 +47,7 @@ inline std::vector<FrameRow> make_frames(const SyntheticOptions& o) {
     }
     row.pan_rad = 0.3 * std::sin(w);
     row.tilt_rad = 0.1 * std::cos(w);
+    row.wall_s = 0.25 + (row.t_s - 1.0) * o.wall_per_sim;
     row.decode_ms = 1.5 + 0.1 * noise(rng);
     row.tracking_ms = 0.05 + 0.01 * unit(rng);
     if (o.with_poses && o.init_frame >= 0 && i >= o.init_frame) {

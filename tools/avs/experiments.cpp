@@ -174,10 +174,11 @@ void add_experiments_command(Command& app) {
         (json ? std::cerr : std::cout)
             << "\n"
             << e.name << " (Sec. " << e.section << ", " << e.run.dir.string() << "/index.html)\n"
-            << table << "\n";
+            << table << report::format_run_clocks(r.summary) << "\n\n";
         markdown += "## " + e.name + " (Sec. " + e.section + ")\n\n" + e.what + ". Report: `" +
                     (e.run.dir / "index.html").string() + "`.\n\n" +
-                    report::format_comparison_markdown(e.run.scenario, r.summary) + "\n";
+                    report::format_comparison_markdown(e.run.scenario, r.summary) + "\n" +
+                    report::format_run_clocks(r.summary) + "\n\n";
         summaries.emplace_back(e.name, r.summary);
       } catch (const std::exception& ex) {
         std::cerr << "avs experiments: " << e.name << ": no report: " << ex.what() << "\n";

@@ -2,6 +2,7 @@
 #include "avs/run_recorder/run_recorder_component.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -78,8 +79,11 @@ runtime::ComponentSpec RunRecorderComponent::spec() {
            ParamSpec::real("depth_snapshot_time_s", 1.0, 0.0, 1e9, "s",
                            "the first depth image at or after this time is kept (Figure 9); "
                            "a shorter run keeps its last one"),
-           ParamSpec::real_list("cloud_snapshot_times_s", {0.5, 1.0, 1.5}, "s",
-                                "scene/model snapshots (Figure 14) at these times")},
+           ParamSpec::real_list("cloud_snapshot_times_s", {}, "s",
+                                "scene/model snapshots (Figure 14) at these times"),
+           ParamSpec::real("cloud_snapshot_period_s", 0.25, 0.0, 1e9, "s",
+                           "and one snapshot every this much simulated time (0: none), so "
+                           "that the report can spread Figure 14 over the whole run")},
       .publishes = {},
       .subscribes = {
           runtime::port<msgs::avs_msgs::GroundTruth>("ground_truth", "/sim/ground_truth", deep),
@@ -105,15 +109,23 @@ RunRecorderComponent::RunRecorderComponent(runtime::ComponentContext& ctx) : Com
   std::filesystem::create_directories(dir);
   recorder_ = std::make_unique<report::RunRecorder>(dir, info);
 
-  assembler_ = std::make_unique<FrameAssembler>(
-      [this](const report::FrameRow& row) { recorder_->write_frame(row); });
+  // The wall clock beside the run's clock gives the report its real-time factor.
+  wall_start_ = std::chrono::steady_clock::now();
+  assembler_ = std::make_unique<FrameAssembler>([this](const report::FrameRow& row) {
+    report::FrameRow timed = row;
+    timed.wall_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+    recorder_->write_frame(timed);
+  });
   depth_snapshot_time_s_ = ctx.param<double>("depth_snapshot_time_s");
   cloud_times_s_ = ctx.param<std::vector<double>>("cloud_snapshot_times_s");
   std::sort(cloud_times_s_.begin(), cloud_times_s_.end());
+  cloud_period_s_ = ctx.param<double>("cloud_snapshot_period_s");
+  next_periodic_cloud_s_ = cloud_period_s_;
 
   std::string model = ctx.param<std::string>("model");
   if (model.empty()) model = info.object;
-  if (!cloud_times_s_.empty()) {
+  if (!cloud_times_s_.empty() || cloud_period_s_ > 0.0) {
     try {
       matching::ModelCloudConfig config;
       config.target_points = 400;
@@ -257,16 +269,19 @@ void RunRecorderComponent::on_pose_camera(const msgs::geometry_msgs::PoseStamped
 }
 
 void RunRecorderComponent::on_scene_points(const msgs::sensor_msgs::PointCloud2& cloud) {
-  if (next_cloud_ >= cloud_times_s_.size()) return;
+  if (clouds_refused_) return;
   const std::int64_t stamp = stamp_ns(cloud.header.stamp);
-  if (static_cast<double>(stamp) * 1e-9 < cloud_times_s_[next_cloud_]) return;
+  const double t_s = static_cast<double>(stamp) * 1e-9;
+  const bool listed_due = next_cloud_ < cloud_times_s_.size() && t_s >= cloud_times_s_[next_cloud_];
+  const bool periodic_due = cloud_period_s_ > 0.0 && t_s >= next_periodic_cloud_s_;
+  if (!listed_due && !periodic_due) return;
   // The model at the pose estimated from this very cloud (published before the cloud).
   if (!last_pose_camera_ || last_pose_camera_->first != stamp) return;
   std::string why;
   const auto points = msg::read_xyz_cloud(cloud, &why);
   if (!points) {
-    rejected_.reject("cloud snapshot skipped: " + why);
-    next_cloud_ = cloud_times_s_.size();
+    rejected_.reject("cloud snapshots stopped: " + why);
+    clouds_refused_ = true;
     return;
   }
   const std::vector<Eigen::Vector3d>& scene = *points;
@@ -274,8 +289,11 @@ void RunRecorderComponent::on_scene_points(const msgs::sensor_msgs::PointCloud2&
   model.reserve(model_points_m_.size());
   for (const auto& p : model_points_m_) model.push_back(last_pose_camera_->second * p);
   if (scene.empty() && model.empty()) return;
-  recorder_->write_cloud_snapshot(static_cast<double>(stamp) * 1e-9, scene, model);
-  ++next_cloud_;
+  recorder_->write_cloud_snapshot(t_s, scene, model);
+  while (next_cloud_ < cloud_times_s_.size() && cloud_times_s_[next_cloud_] <= t_s) ++next_cloud_;
+  if (cloud_period_s_ > 0.0) {
+    next_periodic_cloud_s_ = (std::floor(t_s / cloud_period_s_) + 1.0) * cloud_period_s_;
+  }
 }
 
 AVS_REGISTER_COMPONENT(RunRecorderComponent);

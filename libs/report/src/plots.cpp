@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "avs/report/summary.hpp"
+#include "avs/report/table.hpp"
 
 extern char** environ;
 
@@ -97,7 +98,42 @@ std::string fig8(const std::string& head) {
          "     '' using 't_s':'centroid_y_px' with lines lw 1.5 lc rgb '#1f77b4' title 'y'\n";
 }
 
-std::string fig10(const std::string& head, bool with_meas) {
+/// A tick step of 1, 2 or 5 times a power of ten that puts at most `max_ticks` ticks on
+/// `span`: gnuplot's own choice crowds the small 3-D panel until the labels overlap.
+double tick_step(double span, int max_ticks) {
+  if (!(span > 0.0) || !std::isfinite(span)) return 0.0;
+  const double raw = span / static_cast<double>(std::max(1, max_ticks - 1));
+  const double decade = std::pow(10.0, std::floor(std::log10(raw)));
+  for (const double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * decade >= raw) return m * decade;
+  }
+  return 10.0 * decade;
+}
+
+/// "set xtics 0.05" for the span of `values` (nothing when it has no span).
+std::string tics_for(const char* axis, const std::vector<double>& values, int max_ticks) {
+  if (values.empty()) return "";
+  const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+  const double step = tick_step(*hi - *lo, max_ticks);
+  if (step <= 0.0) return "";
+  std::ostringstream s;
+  s << "set " << axis << "tics " << step;
+  // The last X tick and the first Y tick meet at the panel's front corner: Y's move aside.
+  if (std::string(axis) == "y") s << " offset 1.5,-0.3";
+  s << "\n";
+  return s.str();
+}
+
+std::string fig10(const std::string& head, bool with_meas, const std::vector<FrameRow>& frames) {
+  std::vector<double> xs, ys, zs;
+  for (const FrameRow& row : frames) {
+    for (const Pose* pose : {&row.truth, row.meas ? &*row.meas : nullptr}) {
+      if (pose == nullptr) continue;
+      xs.push_back(pose->p_world_m.x());
+      ys.push_back(pose->p_world_m.y());
+      zs.push_back(pose->p_world_m.z());
+    }
+  }
   std::ostringstream s;
   s << head
     << "set multiplot layout 1,2 title 'Centroid of the target, world frame (cf. paper "
@@ -109,7 +145,8 @@ std::string fig10(const std::string& head, bool with_meas) {
     << "     '' using 't_s':'true_z_m' with lines lw 1.5 title 'Z'\n"
     << "set title '(b) 3-D trajectory'\nset xlabel 'X [m]'\nset ylabel 'Y [m]'\n"
     << "set zlabel 'Z [m]' rotate parallel\nset view 60,35\nset ticslevel 0\n"
-    << "set tics font ',8'\nsplot ";
+    << "set tics font ',8'\n"
+    << tics_for("x", xs, 4) << tics_for("y", ys, 4) << tics_for("z", zs, 5) << "splot ";
   if (with_meas) {
     s << kFrames
       << " using 'meas_x_m':'meas_y_m':'meas_z_m' with points pt 7 ps 0.2 lc rgb "
@@ -194,6 +231,38 @@ std::string fig16(const std::string& head) {
       << "' with lines lw 1.5 lc rgb '#1f77b4' title 'true'\n";
   }
   s << "unset multiplot\n";
+  return s.str();
+}
+
+std::string pose_error(const std::string& head, const Summary& summary) {
+  std::ostringstream s;
+  s << head
+    << "set multiplot layout 2,1 title 'Pose error against ground truth over time (the "
+       "millimetres Figs. 15 and 16 hide)'\n"
+    << "set xlabel 'time [s]'\nset key inside top right\n"
+    << "set title '(a) position: |p_measured - p_true|, RMS "
+    << format_figure(summary.position_error_mm_rms)
+    << " mm'\nset ylabel 'error [mm]'\nset yrange [0:*]\n"
+    << "plot " << kFrames
+    << " using 't_s':'position_error_mm' with lines lw 1 lc rgb '#d62728' title 'position',\\\n"
+    << "     " << summary.position_error_mm_rms
+    << " with lines dt 2 lc rgb '#444444' title 'RMS'\n";
+  const double rms_kept = summary.orientation_error_deg_rms_excluding_flips;
+  s << "set title '(b) orientation: rotation angle from the truth (symmetry applied), RMS "
+    << format_figure(rms_kept) << " deg";
+  if (summary.flips > 0 && std::isfinite(rms_kept)) {
+    // A flip (about 180 deg) would squash the millimetre-scale detail; it is cut off and said.
+    s << ", " << format_figure(summary.flips) << " flips (> " << kFlipThresholdDeg
+      << " deg) off the top'\n"
+      << "set yrange [0:" << std::max(5.0, 4.0 * rms_kept) << "]\n";
+  } else {
+    s << "'\nset yrange [0:*]\n";
+  }
+  s << "set ylabel 'error [deg]'\nplot " << kFrames
+    << " using 't_s':'orientation_error_deg' with lines lw 1 lc rgb '#1f77b4' title "
+       "'orientation',\\\n"
+    << "     " << (std::isfinite(rms_kept) ? rms_kept : 0.0)
+    << " with lines dt 2 lc rgb '#444444' title 'RMS'\nunset multiplot\n";
   return s.str();
 }
 
@@ -381,7 +450,13 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
   const bool depth_ok = run.depth && depth_range(*run.depth, lo, hi);
   jobs.push_back({"fig9_depth", "Depth map",
                   "Depth map snapshot coloured by distance from the camera: red near, blue far, "
-                  "black where no depth was decoded (paper Fig. 9, right).",
+                  "black where no depth was decoded (paper Fig. 9, right). Black next to the "
+                  "target is its shadow: the projector sits beside the camera (Sec. 4), so the "
+                  "wall behind the target is hidden from the projector there; black at the "
+                  "borders is what the projector does not light, and single black pixels failed "
+                  "the |I_pos - I_neg| >= psi test. The faint bands on the wall are depth "
+                  "quantisation: depth comes from the Gray code (Eq. 4), whose code changes in "
+                  "steps across the wall.",
                   !run.depth  ? "the run wrote no depth snapshot"
                   : !depth_ok ? "the depth snapshot has no valid pixel"
                               : "",
@@ -395,7 +470,7 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
                   "trajectory, with the measured one where matching ran (paper Fig. 10).",
                   no_frames ? "no frames" : ""});
   if (jobs.back().skip_reason.empty()) {
-    jobs.back().body = fig10(head(jobs.back().name, true), d.any_pose);
+    jobs.back().body = fig10(head(jobs.back().name, true), d.any_pose, run.frames);
   }
 
   jobs.push_back({"fig13_points_and_time", "S-PCD points and processing time",
@@ -405,8 +480,9 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
   if (jobs.back().skip_reason.empty()) jobs.back().body = fig13(head(jobs.back().name, true), d);
 
   jobs.push_back({"fig14_clouds", "Model over scene",
-                  "Model points at the estimated pose over the scene points, at up to four "
-                  "instants (paper Fig. 14).",
+                  "Model points at the estimated pose over the scene points, seen from the "
+                  "camera, at up to four instants spread over the whole run (the recorder "
+                  "keeps a snapshot every cloud_snapshot_period_s; paper Fig. 14).",
                   run.clouds.empty() ? "the run wrote no cloud snapshot" : ""});
   if (jobs.back().skip_reason.empty()) {
     jobs.back().body = fig14(head(jobs.back().name, true), run.clouds);
@@ -417,6 +493,15 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
                   "truth (paper Fig. 15).",
                   !d.any_pose ? "no frame has a pose estimate" : ""});
   if (jobs.back().skip_reason.empty()) jobs.back().body = fig15(head(jobs.back().name, true));
+
+  jobs.push_back({"pose_error", "Pose error over time",
+                  "Position and orientation error of every pose estimate against the "
+                  "simulator's ground truth, with their RMS (dashed): the errors behind the "
+                  "table's RMS rows, too small to see in Figs. 15 and 16.",
+                  !d.any_pose ? "no frame has a pose estimate" : ""});
+  if (jobs.back().skip_reason.empty()) {
+    jobs.back().body = pose_error(head(jobs.back().name, true), compute_summary(run));
+  }
 
   jobs.push_back({"fig16_quaternion", "Orientation, measured vs true",
                   "Quaternion of the target in world coordinates: matching result against ground "

@@ -1,5 +1,6 @@
 #include "avs/report/report.hpp"
 
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -28,7 +29,8 @@ const char* const kStyle =
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:.3em .6em}
 th{background:#f0f0f0;text-align:left}td.num{text-align:right;font-variant-numeric:tabular-nums}
 figure{margin:2em 0}figure img{max-width:100%;border:1px solid #ddd}
-figcaption{color:#444;margin-top:.4em}.warn{color:#a00}code{background:#f4f4f4;padding:0 .2em})";
+figcaption{color:#444;margin-top:.4em}.warn{color:#a00}td.fail{color:#a00;font-weight:bold}
+td.pass{color:#070}code{background:#f4f4f4;padding:0 .2em})";
 
 }  // namespace
 
@@ -41,8 +43,12 @@ std::string render_index_html(const RunInfo& info, const Summary& summary, const
     << "<h1>avs report: " << runtime::escape_markup(info.scenario) << "</h1>\n"
     << "<p>Target <b>" << runtime::escape_markup(info.object) << "</b> (symmetry <code>"
     << runtime::escape_markup(info.symmetry) << "</code>), " << format_figure(summary.frames)
-    << " depth updates over " << format_figure(summary.duration_s)
-    << " s of simulation time. Every number and figure below is computed from this folder's "
+    << " depth updates over " << format_figure(summary.duration_s) << " s of simulation time";
+  if (std::isfinite(summary.real_time_factor)) {
+    h << " (" << format_figure(summary.wall_duration_s) << " s of wall-clock time, real-time "
+      << "factor " << format_figure(summary.real_time_factor) << ")";
+  }
+  h << ". Every number and figure below is computed from this folder's "
        "<a href=\"frames.csv\">frames.csv</a> by <code>avs report</code>; the paper's column "
        "quotes Sec. 7 of the paper.</p>\n";
   if (!info.notes.empty()) h << "<p>" << runtime::escape_markup(info.notes) << "</p>\n";
@@ -51,13 +57,20 @@ std::string render_index_html(const RunInfo& info, const Summary& summary, const
   }
 
   // 1. Results: the paper beside ours.
-  h << "<h2>Results</h2>\n<table>\n<tr><th>figure</th><th>paper</th><th>ours</th><th>unit</th>"
-       "<th>section</th></tr>\n";
+  h << "<h2>Results</h2>\n<p>" << runtime::escape_markup(format_run_clocks(summary))
+    << "</p>\n<table>\n<tr>";
+  for (const std::string& header : comparison_headers()) h << "<th>" << header << "</th>";
+  h << "</tr>\n";
   for (const ComparisonRow& row : comparison_rows(info.scenario, summary)) {
-    h << "<tr><td>" << runtime::escape_markup(row.label) << "</td><td class=\"num\">"
-      << runtime::escape_markup(row.paper) << "</td><td class=\"num\">" << format_figure(row.ours)
-      << "</td><td>" << runtime::escape_markup(row.unit) << "</td><td>"
-      << runtime::escape_markup(row.section) << "</td></tr>\n";
+    const char* verdict_class = row.verdict.rfind("FAIL", 0) == 0   ? " class=\"fail\""
+                                : row.verdict.rfind("pass", 0) == 0 ? " class=\"pass\""
+                                                                    : "";
+    h << "<tr><td>" << runtime::escape_markup(row.label) << "</td><td>"
+      << runtime::escape_markup(row.statistic) << "</td><td>" << runtime::escape_markup(row.clock)
+      << "</td><td class=\"num\">" << runtime::escape_markup(row.paper) << "</td><td class=\"num\">"
+      << format_figure(row.ours) << "</td><td>" << runtime::escape_markup(row.unit) << "</td><td"
+      << verdict_class << ">" << runtime::escape_markup(row.verdict.empty() ? "-" : row.verdict)
+      << "</td><td>" << runtime::escape_markup(row.section) << "</td></tr>\n";
   }
   h << "</table>\n<p>" << runtime::escape_markup(kPaperNote) << "</p>\n";
 
@@ -127,7 +140,9 @@ int report_main(const fs::path& dir, std::ostream& out, std::ostream& err,
     const Report report = make_report(dir, options);
     out << "avs report: " << report.info.scenario << " (" << report.info.object << "), "
         << format_figure(report.summary.frames) << " depth updates\n\n"
-        << format_comparison_table(report.info.scenario, report.summary) << kPaperNote << "\n\n";
+        << format_comparison_table(report.info.scenario, report.summary)
+        << format_run_clocks(report.summary) << "\n"
+        << kPaperNote << "\n\n";
     for (const std::string& warning : report.warnings) err << "warning: " << warning << "\n";
     for (const SkippedPlot& s : report.plots.skipped) {
       out << "not made: " << s.png << " (" << s.reason << ")\n";

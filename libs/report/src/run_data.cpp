@@ -69,6 +69,7 @@ std::vector<FrameRow> read_frames(const fs::path& file, std::vector<std::string>
   const std::size_t c_decode = table.column("decode_ms");
   const std::size_t c_tracking = table.column("tracking_ms");
   const std::size_t c_matching = table.column("matching_ms");
+  const std::optional<std::size_t> c_wall = table.find_column("wall_s");  // newer folders only
 
   std::vector<FrameRow> frames;
   frames.reserve(table.rows());
@@ -99,6 +100,7 @@ std::vector<FrameRow> read_frames(const fs::path& file, std::vector<std::string>
     row.decode_ms = table.optional_number(r, c_decode);
     row.tracking_ms = table.optional_number(r, c_tracking);
     row.matching_ms = table.optional_number(r, c_matching);
+    if (c_wall) row.wall_s = table.optional_number(r, *c_wall);
     if (row.match_state == MatchState::init && !row.matching_ms) {
       throw ReportError(table.where(r, c_matching) +
                         ": an 'init' row must carry the initial alignment time");
@@ -270,7 +272,8 @@ const std::vector<std::string>& frames_columns() {
       "true_qy",     "true_qz",       "meas_x_m",          "meas_y_m",
       "meas_z_m",    "meas_qw",       "meas_qx",           "meas_qy",
       "meas_qz",     "match_state",   "scene_points",      "decode_ms",
-      "tracking_ms", "matching_ms",   "position_error_mm", "orientation_error_deg"};
+      "tracking_ms", "matching_ms",   "position_error_mm", "orientation_error_deg",
+      "wall_s"};
   return columns;
 }
 
@@ -343,6 +346,7 @@ void RunRecorder::write_frame(const FrameRow& row) {
   } else {
     line += ",,";
   }
+  append(line, row.wall_s);
   frames_ << line << '\n';
   if (!frames_) throw ReportError((dir_ / kFramesFile).string() + ": write failed");
   ++frames_written_;

@@ -147,6 +147,12 @@ Summary compute_summary(const std::vector<FrameRow>& frames, const Symmetry& sym
   s.pose_frames = static_cast<double>(
       std::count_if(frames.begin(), frames.end(), [](const FrameRow& r) { return r.meas; }));
   s.pose_rate_hz = s.depth_rate_hz * s.pose_frames / s.frames;
+  if (frames.front().wall_s && frames.back().wall_s) {
+    s.wall_duration_s = *frames.back().wall_s - *frames.front().wall_s;
+    if (s.wall_duration_s > 0.0 && s.duration_s > 0.0) {
+      s.real_time_factor = s.duration_s / s.wall_duration_s;
+    }
+  }
 
   // 2. Stage times. The initial alignment is reported on its own (init_ms).
   stage_stats(collect(frames, [](const FrameRow& r) { return r.decode_ms; }), s.decode_ms_median,
@@ -222,56 +228,93 @@ Summary compute_summary(const std::vector<FrameRow>& frames, const Symmetry& sym
   return s;
 }
 
+const char* figure_clock_name(FigureClock clock) {
+  switch (clock) {
+    case FigureClock::sim:
+      return "sim";
+    case FigureClock::wall:
+      return "wall";
+    case FigureClock::none:
+      break;
+  }
+  return "-";
+}
+
 const std::vector<SummaryField>& summary_fields() {
+  constexpr FigureClock sim = FigureClock::sim;
+  constexpr FigureClock wall = FigureClock::wall;
+  constexpr FigureClock none = FigureClock::none;
+  // Processing times are wall-clock durations of each callback on this machine, whatever the
+  // run's clock; rates count updates per second of the run's (simulated) clock.
   static const std::vector<SummaryField> fields{
-      {"frames", &Summary::frames, "depth updates recorded"},
-      {"duration_s", &Summary::duration_s, "recorded span of simulation time"},
-      {"depth_rate_hz", &Summary::depth_rate_hz, "depth updates per second"},
-      {"pose_rate_hz", &Summary::pose_rate_hz, "pose estimates per second"},
-      {"pose_frames", &Summary::pose_frames, "updates with a pose estimate"},
-      {"decode_ms_median", &Summary::decode_ms_median, "depth computation, median"},
-      {"decode_ms_p99", &Summary::decode_ms_p99, "depth computation, 99th percentile"},
-      {"decode_ms_max", &Summary::decode_ms_max, "depth computation, max"},
-      {"tracking_ms_median", &Summary::tracking_ms_median, "moments + servo law, median"},
-      {"tracking_ms_p99", &Summary::tracking_ms_p99, "moments + servo law, 99th percentile"},
-      {"tracking_ms_max", &Summary::tracking_ms_max, "moments + servo law, max"},
-      {"matching_ms_median", &Summary::matching_ms_median, "matching per update, median"},
-      {"matching_ms_p99", &Summary::matching_ms_p99, "matching per update, 99th percentile"},
-      {"matching_ms_max", &Summary::matching_ms_max, "matching per update, max"},
-      {"init_ms", &Summary::init_ms, "initial alignment time"},
-      {"init_count", &Summary::init_count, "initial alignments"},
-      {"position_error_mm_rms", &Summary::position_error_mm_rms, "position error, RMS"},
-      {"position_error_mm_median", &Summary::position_error_mm_median, "position error, median"},
-      {"position_error_mm_p99", &Summary::position_error_mm_p99, "position error, 99th pct"},
-      {"position_error_mm_max", &Summary::position_error_mm_max, "position error, max"},
+      {"frames", &Summary::frames, "depth updates recorded", "count", none},
+      {"duration_s", &Summary::duration_s, "recorded span of simulation time", "span", sim},
+      {"wall_duration_s", &Summary::wall_duration_s, "the same span on the wall clock", "span",
+       wall},
+      {"real_time_factor", &Summary::real_time_factor, "simulated seconds per wall-clock second",
+       "ratio", none},
+      {"depth_rate_hz", &Summary::depth_rate_hz, "depth updates per second", "mean rate", sim},
+      {"pose_rate_hz", &Summary::pose_rate_hz, "pose estimates per second", "mean rate", sim},
+      {"pose_frames", &Summary::pose_frames, "updates with a pose estimate", "count", none},
+      {"decode_ms_median", &Summary::decode_ms_median, "depth computation, median", "median", wall},
+      {"decode_ms_p99", &Summary::decode_ms_p99, "depth computation, 99th percentile", "p99", wall},
+      {"decode_ms_max", &Summary::decode_ms_max, "depth computation, max", "max", wall},
+      {"tracking_ms_median", &Summary::tracking_ms_median, "moments + servo law, median", "median",
+       wall},
+      {"tracking_ms_p99", &Summary::tracking_ms_p99, "moments + servo law, 99th percentile", "p99",
+       wall},
+      {"tracking_ms_max", &Summary::tracking_ms_max, "moments + servo law, max", "max", wall},
+      {"matching_ms_median", &Summary::matching_ms_median, "matching per update, median", "median",
+       wall},
+      {"matching_ms_p99", &Summary::matching_ms_p99, "matching per update, 99th percentile", "p99",
+       wall},
+      {"matching_ms_max", &Summary::matching_ms_max, "matching per update, max", "max", wall},
+      {"init_ms", &Summary::init_ms, "initial alignment time", "first", wall},
+      {"init_count", &Summary::init_count, "initial alignments", "count", none},
+      {"position_error_mm_rms", &Summary::position_error_mm_rms, "position error, RMS", "RMS",
+       none},
+      {"position_error_mm_median", &Summary::position_error_mm_median, "position error, median",
+       "median", none},
+      {"position_error_mm_p99", &Summary::position_error_mm_p99, "position error, 99th pct", "p99",
+       none},
+      {"position_error_mm_max", &Summary::position_error_mm_max, "position error, max", "max",
+       none},
       {"orientation_error_deg_rms", &Summary::orientation_error_deg_rms,
-       "orientation error, RMS (flips included)"},
+       "orientation error, RMS (flips included)", "RMS", none},
       {"orientation_error_deg_median", &Summary::orientation_error_deg_median,
-       "orientation error, median"},
+       "orientation error, median", "median", none},
       {"orientation_error_deg_p99", &Summary::orientation_error_deg_p99,
-       "orientation error, 99th percentile"},
+       "orientation error, 99th percentile", "p99", none},
       {"orientation_error_deg_rms_excluding_flips",
-       &Summary::orientation_error_deg_rms_excluding_flips, "orientation error, RMS without flips"},
-      {"flips", &Summary::flips, "updates with orientation error > 150 deg"},
-      {"flip_fraction", &Summary::flip_fraction, "flips / updates with a pose"},
-      {"in_view_fraction", &Summary::in_view_fraction, "target inside the image (ground truth)"},
-      {"target_valid_fraction", &Summary::target_valid_fraction, "target segmented"},
+       &Summary::orientation_error_deg_rms_excluding_flips, "orientation error, RMS without flips",
+       "RMS", none},
+      {"flips", &Summary::flips, "updates with orientation error > 150 deg", "count", none},
+      {"flip_fraction", &Summary::flip_fraction, "flips / updates with a pose", "fraction", none},
+      {"in_view_fraction", &Summary::in_view_fraction, "target inside the image (ground truth)",
+       "fraction", none},
+      {"target_valid_fraction", &Summary::target_valid_fraction, "target segmented", "fraction",
+       none},
       {"centroid_error_px_rms", &Summary::centroid_error_px_rms,
-       "image centroid to image centre, RMS"},
+       "image centroid to image centre, RMS", "RMS", none},
       {"centroid_error_px_max", &Summary::centroid_error_px_max,
-       "image centroid to image centre, max"},
-      {"scene_points_median", &Summary::scene_points_median, "S-PCD points, median"},
-      {"scene_points_min", &Summary::scene_points_min, "S-PCD points, min"},
-      {"scene_points_max", &Summary::scene_points_max, "S-PCD points, max"},
+       "image centroid to image centre, max", "max", none},
+      {"scene_points_median", &Summary::scene_points_median, "S-PCD points, median", "median",
+       none},
+      {"scene_points_min", &Summary::scene_points_min, "S-PCD points, min", "min", none},
+      {"scene_points_max", &Summary::scene_points_max, "S-PCD points, max", "max", none},
   };
   return fields;
 }
 
-double summary_value(const Summary& summary, const std::string& key) {
+const SummaryField& summary_field(const std::string& key) {
   for (const SummaryField& field : summary_fields()) {
-    if (key == field.key) return summary.*field.member;
+    if (key == field.key) return field;
   }
   throw ReportError("unknown summary key '" + key + "'");
+}
+
+double summary_value(const Summary& summary, const std::string& key) {
+  return summary.*summary_field(key).member;
 }
 
 std::string json_string(const std::string& text) {

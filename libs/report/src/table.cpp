@@ -75,26 +75,71 @@ std::string format_figure(double value) {
   return buffer;
 }
 
+const std::vector<std::string>& comparison_headers() {
+  static const std::vector<std::string> headers{"figure", "statistic", "clock",   "paper",
+                                                "ours",   "unit",      "verdict", "section"};
+  return headers;
+}
+
+namespace {
+
+std::vector<std::string> comparison_cells(const ComparisonRow& row) {
+  return {row.label,
+          row.statistic,
+          row.clock,
+          row.paper,
+          format_figure(row.ours),
+          row.unit,
+          row.verdict.empty() ? "-" : row.verdict,
+          row.section};
+}
+
+}  // namespace
+
 std::string format_comparison_table(const std::string& scenario, const Summary& summary) {
-  TextTable table({"figure", "paper", "ours", "unit", "section"});
+  TextTable table(comparison_headers());
   for (const ComparisonRow& row : comparison_rows(scenario, summary)) {
-    table.add_row({row.label, row.paper, format_figure(row.ours), row.unit, row.section});
+    table.add_row(comparison_cells(row));
   }
   return table.render();
 }
 
 std::string format_comparison_markdown(const std::string& scenario, const Summary& summary) {
-  const auto cell = [](std::string text) {
+  const auto cell = [](const std::string& text) {
     std::string out;
     for (const char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
     return out;
   };
-  std::string out = "| figure | paper | ours | unit | section |\n|---|---:|---:|---|---|\n";
+  std::string out = "|";
+  std::string rule = "|";
+  for (const std::string& header : comparison_headers()) {
+    out += " " + header + " |";
+    rule += header == "paper" || header == "ours" ? "---:|" : "---|";
+  }
+  out += "\n" + rule + "\n";
   for (const ComparisonRow& row : comparison_rows(scenario, summary)) {
-    out += "| " + cell(row.label) + " | " + cell(row.paper) + " | " + format_figure(row.ours) +
-           " | " + cell(row.unit) + " | " + cell(row.section) + " |\n";
+    out += "|";
+    for (const std::string& text : comparison_cells(row)) out += " " + cell(text) + " |";
+    out += "\n";
   }
   return out;
+}
+
+std::string format_run_clocks(const Summary& summary) {
+  std::string out = "Run: " + format_figure(summary.duration_s) + " s of simulated time";
+  if (std::isfinite(summary.wall_duration_s)) {
+    out += " in " + format_figure(summary.wall_duration_s) + " s of wall-clock time";
+  }
+  if (std::isfinite(summary.real_time_factor)) {
+    out += " (real-time factor " + format_figure(summary.real_time_factor) + ")";
+  } else {
+    out += " (real-time factor unknown: the run folder has no wall_s)";
+  }
+  return out +
+         ". Clock 'sim': per second of simulated time; 'wall': measured on this machine's "
+         "wall clock (on its CPU; the paper's depth computation ran on a GPU); '-': against "
+         "ground truth. A verdict compares ours with the paper's limit (rates within " +
+         format_figure(kRateTolerance * 100.0) + " % of the paper's).";
 }
 
 }  // namespace avs::report

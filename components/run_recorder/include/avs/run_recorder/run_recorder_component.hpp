@@ -6,6 +6,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -57,6 +58,10 @@ class RunRecorderComponent final : public runtime::Component {
   std::string truth_object_;
   std::set<std::string> other_objects_;
   std::vector<double> cloud_times_s_;
+  double cloud_period_s_ = 0.0;
+  double next_periodic_cloud_s_ = 0.0;
+  bool clouds_refused_ = false;  ///< a cloud that cannot be read stops the snapshots
+  std::chrono::steady_clock::time_point wall_start_;
   std::size_t next_cloud_ = 0;
   std::vector<Eigen::Vector3d> model_points_m_;
   std::optional<std::pair<std::int64_t, Eigen::Isometry3d>> last_pose_camera_;

@@ -69,6 +69,9 @@ struct FrameRow {
   std::optional<double> decode_ms;    ///< depth computation time (Sec. 4), empty if not run
   std::optional<double> tracking_ms;  ///< moments + servo law time (Sec. 3)
   std::optional<double> matching_ms;  ///< ICP time (Fig. 13b), or the initial alignment time
+  /// Wall-clock (steady) seconds since the recorder started, when the row was complete: with
+  /// t_s it gives the run's real-time factor. Empty in run folders written before it existed.
+  std::optional<double> wall_s;
 };
 
 /// A depth map to colour like Figure 9. Row-major, top image row first, metres along the

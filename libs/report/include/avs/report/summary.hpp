@@ -55,6 +55,11 @@ inline constexpr double kUndefined = std::numeric_limits<double>::quiet_NaN();
 struct Summary {
   double frames = 0;               ///< depth updates (rows of frames.csv)
   double duration_s = kUndefined;  ///< last minus first t_s
+  /// Wall-clock time over the same rows (last minus first wall_s), and the run's real-time
+  /// factor duration_s / wall_duration_s (0.2: a second of simulation took 5 s). NaN for a
+  /// run folder without wall_s.
+  double wall_duration_s = kUndefined;
+  double real_time_factor = kUndefined;
   double depth_rate_hz = kUndefined;
   double pose_rate_hz = kUndefined;  ///< poses per second (the ICP rate of Sec. 7.2)
   double pose_frames = 0;            ///< frames with a pose estimate
@@ -82,14 +87,23 @@ struct Summary {
          scene_points_max = kUndefined;  ///< over frames where matching ran
 };
 
+/// Which clock a figure is measured on: rates per second of simulated time, processing times
+/// on this machine's wall clock, errors against ground truth at the simulated instants.
+enum class FigureClock { sim, wall, none };
+[[nodiscard]] const char* figure_clock_name(FigureClock clock);  ///< "sim", "wall", "-"
+
 /// One named figure of a summary (keys carry units, e.g. "decode_ms_p99").
 struct SummaryField {
   const char* key;
   double Summary::*member;
   const char* description;
+  const char* statistic;  ///< over the run's updates: "median", "p99", "max", "RMS", "rate", ...
+  FigureClock clock;
 };
 /// Every field, in the order of summary.json.
 [[nodiscard]] const std::vector<SummaryField>& summary_fields();
+/// The field named `key`; throws ReportError for an unknown key.
+[[nodiscard]] const SummaryField& summary_field(const std::string& key);
 /// Value of `key`; throws ReportError for an unknown key.
 [[nodiscard]] double summary_value(const Summary& summary, const std::string& key);
 

@@ -24,12 +24,20 @@ class TextTable {
 /// A figure for a table: "-" for NaN, integers without decimals, else 4 significant digits.
 [[nodiscard]] std::string format_figure(double value);
 
-/// The results table of a run: figure | paper | ours | unit | section.
+/// The columns of the results table, in order.
+[[nodiscard]] const std::vector<std::string>& comparison_headers();
+
+/// The results table of a run: figure | statistic | clock | paper | ours | unit | verdict |
+/// section (comparison_headers()).
 [[nodiscard]] std::string format_comparison_table(const std::string& scenario,
                                                   const Summary& summary);
 
 /// The same table as GitHub-flavoured Markdown (for docs/experiments.md).
 [[nodiscard]] std::string format_comparison_markdown(const std::string& scenario,
                                                      const Summary& summary);
+
+/// What the table's clocks mean for this run, with its real-time factor: "Run: 3 s of
+/// simulated time in 17.6 s of wall-clock time (real-time factor 0.17). Clock 'sim': ...".
+[[nodiscard]] std::string format_run_clocks(const Summary& summary);
 
 }  // namespace avs::report
