@@ -146,7 +146,7 @@ TEST(RunFiles, WrongFieldCountNamesFileAndLine) {
   TempDir tmp("field_count");
   write_run(tmp.path());
   replace_line(tmp.path() / kFramesFile, 7, line_of(tmp.path() / kFramesFile, 7) + ",42");
-  expect_error(tmp.path(), "frames.csv:7: expected 28 fields (as in the header), got 29");
+  expect_error(tmp.path(), "frames.csv:7: expected 29 fields (as in the header), got 30");
 }
 
 TEST(RunFiles, BadNumberNamesFileLineAndColumn) {
@@ -178,7 +178,21 @@ TEST(RunFiles, RowCutShortByAKilledWriterIsDroppedWithAWarning) {
       << run.warnings[0];
   // The same row with its newline is a malformed row, not a cut one.
   write_text(tmp.path() / kFramesFile, text + "\n");
-  expect_error(tmp.path(), "frames.csv:22: expected 28 fields (as in the header), got 3");
+  expect_error(tmp.path(), "frames.csv:22: expected 29 fields (as in the header), got 3");
+}
+
+TEST(RunFiles, AFolderFromBeforeTheWallClockColumnStillLoads) {
+  TempDir tmp("without_wall_s");
+  write_run(tmp.path(), 20);
+  // Drop the last column (wall_s) from every line, as older recorders wrote them.
+  std::istringstream in(read_text(tmp.path() / kFramesFile));
+  std::string old;
+  for (std::string line; std::getline(in, line);) old += line.substr(0, line.rfind(',')) + "\n";
+  ASSERT_EQ(old.find("wall_s"), std::string::npos);
+  write_text(tmp.path() / kFramesFile, old);
+  const RunData run = load_run(tmp.path());
+  ASSERT_EQ(run.frames.size(), 20U);
+  EXPECT_FALSE(run.frames.front().wall_s.has_value());
 }
 
 TEST(RunFiles, MissingColumnIsReportedOnTheHeaderLine) {
