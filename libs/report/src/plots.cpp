@@ -252,9 +252,10 @@ std::string pose_error(const std::string& head, const Summary& summary) {
     << format_figure(rms_kept) << " deg";
   if (summary.flips > 0 && std::isfinite(rms_kept)) {
     // A flip (about 180 deg) would squash the millimetre-scale detail; it is cut off and said.
-    s << ", " << format_figure(summary.flips) << " flips (> " << kFlipThresholdDeg
-      << " deg) off the top'\n"
-      << "set yrange [0:" << std::max(5.0, 4.0 * rms_kept) << "]\n";
+    const double cut_deg = std::max(5.0, 4.0 * rms_kept);
+    s << "; axis cut at " << format_figure(cut_deg) << " deg, " << format_figure(summary.flips)
+      << " flips (> " << kFlipThresholdDeg << " deg) and any error above the cut off the top'\n"
+      << "set yrange [0:" << cut_deg << "]\n";
   } else {
     s << "'\nset yrange [0:*]\n";
   }
@@ -451,11 +452,12 @@ PlotResult make_plots(const RunData& run, const PlotConfig& config) {
   jobs.push_back({"fig9_depth", "Depth map",
                   "Depth map snapshot coloured by distance from the camera: red near, blue far, "
                   "black where no depth was decoded (paper Fig. 9, right). Black next to the "
-                  "target is its shadow: the projector sits beside the camera (Sec. 4), so the "
+                  "target is its shadow: the projector sits beside the camera (Sec. 4.3), so the "
                   "wall behind the target is hidden from the projector there; black at the "
                   "borders is what the projector does not light, and single black pixels failed "
-                  "the |I_pos - I_neg| >= psi test. The faint bands on the wall are depth "
-                  "quantisation: depth comes from the Gray code (Eq. 4), whose code changes in "
+                  "the |I_pos - I_neg| > psi test (Eq. 2). The faint bands on the wall are depth "
+                  "quantisation: depth is triangulated (Eq. 4) from the Gray code (Eqs. 1-3), "
+                  "whose code changes in "
                   "steps across the wall.",
                   !run.depth  ? "the run wrote no depth snapshot"
                   : !depth_ok ? "the depth snapshot has no valid pixel"

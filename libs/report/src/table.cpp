@@ -133,7 +133,7 @@ std::string format_run_clocks(const Summary& summary) {
   if (std::isfinite(summary.real_time_factor)) {
     out += " (real-time factor " + format_figure(summary.real_time_factor) + ")";
   } else {
-    out += " (real-time factor unknown: the run folder has no wall_s)";
+    out += " (real-time factor unknown: no wall_s in the run folder, or a single row)";
   }
   return out +
          ". Clock 'sim': per second of simulated time; 'wall': measured on this machine's "
