@@ -167,7 +167,8 @@ class TestMatchingRecorder final : public runtime::Component {
                 runtime::port<msgs::geometry_msgs::PoseStamped>("world", "/object/pose_world"),
                 runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match"),
                 runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing"),
-                runtime::port<msgs::sensor_msgs::PointCloud2>("cloud", "/object/scene_points")}};
+                runtime::port<msgs::sensor_msgs::PointCloud2>("cloud", "/object/scene_points"),
+                runtime::port<msgs::sensor_msgs::PointCloud2>("model", "/object/model_points")}};
   }
   explicit TestMatchingRecorder(ComponentContext& ctx) : Component(ctx) {
     auto pose_cb = [](std::vector<PoseRecord>& out) {
@@ -189,7 +190,21 @@ class TestMatchingRecorder final : public runtime::Component {
         "cloud", [this](runtime::SamplePtr<msgs::sensor_msgs::PointCloud2> m) {
           clouds.push_back(m->width);
         });
+    ctx.subscribe<msgs::sensor_msgs::PointCloud2>(
+        "model", [this](runtime::SamplePtr<msgs::sensor_msgs::PointCloud2> m) {
+          auto points = msg::read_xyz_cloud(*m);
+          ASSERT_TRUE(points.has_value());
+          models.push_back({runtime::from_ros_time(m->header.stamp).ns,
+                            std::string(runtime::get_string(m->header.frame_id)),
+                            std::move(*points)});
+        });
   }
+  struct ModelCloudRecord {
+    std::int64_t stamp_ns = 0;
+    std::string frame;
+    std::vector<Eigen::Vector3d> points_m;
+  };
+  std::vector<ModelCloudRecord> models;
   std::vector<PoseRecord> camera, world;
   std::vector<runtime::SamplePtr<msgs::avs_msgs::MatchResult>> match;
   std::vector<std::uint32_t> clouds;
@@ -287,6 +302,45 @@ TEST(MatchingComponent, PosesAtTheDepthRateInCameraAndWorldFrames) {
   EXPECT_LT(std::sqrt(sum_deg / static_cast<double>(depth.size())), 2.0);
 }
 
+// /object/model_points: the M-PCD at each published pose (the model over the scene in a
+// viewer). Moved back by its pose, every cloud is the same model-frame cloud; at the pose it
+// lies where the ground truth puts the model.
+TEST(MatchingComponent, TheModelCloudAtEachPose) {
+  GraphRun run = run_graph(0.1, "{model: ken, publish_model_points: true}");
+  ASSERT_NE(run.recorder, nullptr);
+  const auto& rec = *run.recorder;
+  ASSERT_GE(rec.camera.size(), 40u);
+  ASSERT_EQ(rec.models.size(), rec.camera.size()) << "one model cloud per pose";
+  const auto in_model = [&](std::size_t i) {
+    std::vector<Eigen::Vector3d> p;
+    for (const auto& x : rec.models[i].points_m) p.push_back(rec.camera[i].T.inverse() * x);
+    return p;
+  };
+  const std::vector<Eigen::Vector3d> model0 = in_model(0);
+  ASSERT_GT(model0.size(), 200u) << "the ken's M-PCD (302 in the paper)";
+  double max_drift_m = 0, max_truth_mm = 0;
+  for (std::size_t i = 0; i < rec.models.size(); ++i) {
+    EXPECT_EQ(rec.models[i].stamp_ns, rec.camera[i].stamp_ns);
+    EXPECT_EQ(rec.models[i].frame, "camera_optical_frame");
+    const std::vector<Eigen::Vector3d> model_i = in_model(i);
+    ASSERT_EQ(model_i.size(), model0.size());
+    const double t = static_cast<double>(rec.camera[i].stamp_ns) * 1e-9;
+    const Eigen::Isometry3d truth_camera =
+        geometry::T_world_camera(head_config(), pan_at(t), kTilt).inverse() * T_world_ken(t);
+    double sum_mm = 0;
+    for (std::size_t k = 0; k < model0.size(); ++k) {
+      max_drift_m = std::max(max_drift_m, (model_i[k] - model0[k]).norm());
+      sum_mm += 1e3 * (rec.models[i].points_m[k] - truth_camera * model0[k]).norm();
+    }
+    max_truth_mm = std::max(max_truth_mm, sum_mm / static_cast<double>(model0.size()));
+  }
+  std::printf("%zu model clouds of %zu points; mean distance to the true model at most %.2f mm\n",
+              rec.models.size(), model0.size(), max_truth_mm);
+  EXPECT_LT(max_drift_m, 1e-5) << "each cloud is the model moved by its own pose";
+  // The pose errors (< 4 mm, < 5 deg over the ken's few cm) bound it; untransformed, ~1 m.
+  EXPECT_LT(max_truth_mm, 10.0) << "at the pose, the cloud lies on the true model";
+}
+
 TEST(MatchingComponent, WithoutJointStatesOnlyTheCameraPoseIsPublished) {
   GraphRun run = run_graph(0.05,
                            "{model: ken, joint_names: 'yaw,pitch'}");  // no such joints
@@ -294,6 +348,7 @@ TEST(MatchingComponent, WithoutJointStatesOnlyTheCameraPoseIsPublished) {
   EXPECT_EQ(run.recorder->camera.size(), run.source->depth_stamps_ns.size());
   EXPECT_TRUE(run.recorder->world.empty());
   EXPECT_TRUE(run.recorder->clouds.empty()) << "scene points are off by default";
+  EXPECT_TRUE(run.recorder->models.empty()) << "model points are off by default";
 }
 
 // Lag compensation by /depth/info: the rendered images have no lag, so an age of 0 from

@@ -76,6 +76,10 @@ class MatchingComponent final : public runtime::Component {
                              "joint states older than this at the image's stamp: no world pose"),
              ParamSpec::boolean("publish_scene_points", false,
                                 "publish the S-PCD on /object/scene_points (camera frame)"),
+             ParamSpec::boolean("publish_model_points", false,
+                                "publish the M-PCD at each pose on /object/model_points (camera "
+                                "frame, stamped like the pose): the model over the scene in a "
+                                "viewer, like Fig. 14"),
              ParamSpec::string("report_dir", "",
                                "tests: write <name>.csv (one row per image) on deactivate")}),
         .publishes = {runtime::port<msgs::geometry_msgs::PoseStamped>("pose", "/object/pose"),
@@ -85,7 +89,9 @@ class MatchingComponent final : public runtime::Component {
                       runtime::port<msgs::avs_msgs::StageTiming>("timing", "/timing",
                                                                  keep_last_100),
                       runtime::port<msgs::sensor_msgs::PointCloud2>(
-                          "scene_points", "/object/scene_points", best_effort_2)},
+                          "scene_points", "/object/scene_points", best_effort_2),
+                      runtime::port<msgs::sensor_msgs::PointCloud2>(
+                          "model_points", "/object/model_points", best_effort_2)},
         .subscribes =
             {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
              runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states"),
@@ -158,6 +164,8 @@ class MatchingComponent final : public runtime::Component {
         timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
         scene_points_(ctx.publisher<msgs::sensor_msgs::PointCloud2>("scene_points")),
         publish_scene_points_(ctx.param<bool>("publish_scene_points")),
+        model_points_(ctx.publisher<msgs::sensor_msgs::PointCloud2>("model_points")),
+        publish_model_points_(ctx.param<bool>("publish_model_points")),
         report_dir_(ctx.param<std::string>("report_dir")),
         max_extrapolation_s_(ctx.param<double>("joint_max_extrapolation_s")),
         use_depth_info_(ctx.param<bool>("use_depth_info")) {
@@ -306,6 +314,7 @@ class MatchingComponent final : public runtime::Component {
       ++poses_;
       const Eigen::Isometry3d T_camera_model = out.T_camera_model.cast<double>();
       publish_pose(pose_, image.header.stamp, geometry::frame::kCameraOptical, T_camera_model);
+      if (publish_model_points_) publish_model(image, out.T_camera_model);
       if (const auto q = joints_.at(stamp_s, max_extrapolation_s_)) {
         T_world_model = geometry::T_world_camera(head_, q->pan_rad, q->tilt_rad) * T_camera_model;
         publish_pose(pose_world_, image.header.stamp, geometry::frame::kWorld, *T_world_model);
@@ -383,6 +392,19 @@ class MatchingComponent final : public runtime::Component {
     scene_points_.publish(std::move(msg));
   }
 
+  /// The M-PCD moved to the published pose: p_camera = T_camera_model p_model.
+  void publish_model(const msgs::sensor_msgs::Image& image,
+                     const Eigen::Isometry3f& T_camera_model) {
+    const Points& model = pipeline_->model().points_m;
+    model_in_camera_.resize(model.size());
+    for (std::size_t i = 0; i < model.size(); ++i) model_in_camera_[i] = T_camera_model * model[i];
+    auto msg = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
+    msg->header.stamp = image.header.stamp;
+    runtime::set_string(msg->header.frame_id, geometry::frame::kCameraOptical);
+    msg::write_xyz_cloud(model_in_camera_, *msg);
+    model_points_.publish(std::move(msg));
+  }
+
   void report(double stamp_s, const PipelineOutput& out,
               const std::optional<Eigen::Isometry3d>& T_world_model) {
     const Eigen::Vector3f p = out.T_camera_model.translation();
@@ -409,6 +431,9 @@ class MatchingComponent final : public runtime::Component {
   std::array<std::string, 2> joint_names_;
   JointHistory joints_;
   bool publish_scene_points_;
+  runtime::Publisher<msgs::sensor_msgs::PointCloud2> model_points_;
+  bool publish_model_points_;
+  Points model_in_camera_;  ///< publish_model's buffer
   std::string report_dir_;
   double max_extrapolation_s_;
   bool use_depth_info_;
