@@ -142,6 +142,8 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
   const Logger& log() const override { return log_; }
   Time now() const override { return container_.scheduler->now(); }
   bool uses_sim_time() const override { return container_.scheduler->mode() != TimeMode::wall; }
+  int dds_domain() const override { return container_.graph.domain_id; }
+  const std::string& dds_partition() const override { return container_.graph.partition; }
 
   TimerId create_timer(Duration period, std::function<void()> callback) override {
     auto ticks = std::make_shared<std::atomic<std::uint64_t>>(0);

@@ -19,6 +19,7 @@
 #include "commands.hpp"
 #include "dds_environment.hpp"
 #include "interrupts.hpp"
+#include "live_view.hpp"
 
 namespace avs::cli {
 
@@ -128,6 +129,7 @@ class RawTerminal {
 struct PlayArgs {
   bag::PlayOptions options;
   std::vector<std::string> remaps;
+  LiveViewFlags view;
 };
 
 int run_play(PlayArgs& a) {
@@ -139,6 +141,9 @@ int run_play(PlayArgs& a) {
     }
     a.options.remaps[r.substr(0, sep)] = r.substr(sep + 2);
   }
+  // Before the player's writers, so that the first messages find their channels.
+  const std::unique_ptr<view::View> live =
+      start_live_view(a.view, a.options.domain, a.options.partition, "avs bag play", std::cerr);
   stop_on_interrupt();
   std::atomic<bool> paused{false};
   std::atomic<bool> done{false};
@@ -197,6 +202,7 @@ int run_play(PlayArgs& a) {
   }
   done = true;
   if (keys.joinable()) keys.join();
+  if (live) live->stop();
   return status;
 }
 
@@ -321,6 +327,7 @@ void add_bag_command(Command& app) {
       ->check_range(1e-3, 1e6);
   pl.options.partition = environment_partition();
   add_domain_option(play, pl.options.domain);
+  add_live_view_options(play, pl.view, "the playback");
   play->callback([] { exit_status() = run_play(pl); });
 
   static std::string info_file;

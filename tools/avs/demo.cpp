@@ -8,9 +8,9 @@
 
 #include "avs/report/report.hpp"
 #include "avs/runtime/error.hpp"
-#include "avs/view/view.hpp"
 #include "closed_loop.hpp"
 #include "commands.hpp"
+#include "live_view.hpp"
 
 namespace avs::cli {
 
@@ -44,12 +44,8 @@ void add_demo_command(Command& app) {
   cmd->add_option("--symmetry", run.symmetry, "object symmetry: none, cube, cylinder_x|y|z")
       ->capture_default_str();
   cmd->add_flag("--no-tracking", no_tracking, "the head holds still (Sec. 7.1.2)");
-  static bool view = false;
-  static unsigned view_port = 8765;
-  cmd->add_flag("--view", view,
-                "serve the run live (avs view: Foxglove WebSocket and the page, docs/view.md)");
-  cmd->add_option("--view-port", view_port, "port of --view (0: any free port)")
-      ->capture_default_str();
+  static LiveViewFlags view;
+  add_live_view_options(cmd, view, "the run");
   static std::string calibration;
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
@@ -67,18 +63,10 @@ void add_demo_command(Command& app) {
     std::cerr << "avs demo: simulated closed loop, " << run.duration_s << " s of sim time in "
               << "lockstep (graph " << closed_loop_graph().string() << ", scene " << run.scene
               << "); Ctrl-C ends it early with a partial report\n";
-    std::unique_ptr<view::View> live;
-    if (view) {
-      if (view_port > 65535) throw runtime::Error("avs demo: --view-port must be in [0, 65535]");
-      view::ViewOptions o;
-      o.domain = choose_closed_loop_domain(run, std::cerr);
-      o.server.port = static_cast<std::uint16_t>(view_port);
-      o.server.web_root = view::built_page_dir();
-      live = std::make_unique<view::View>(o);
-      live->start();
-      std::cerr << "avs demo: live view at http://127.0.0.1:" << live->port()
-                << "/ (Foxglove: ws://127.0.0.1:" << live->port() << ")\n";
-    }
+    const std::unique_ptr<view::View> live =
+        view.enabled ? start_live_view(view, choose_closed_loop_domain(run, std::cerr), "",
+                                       "avs demo", std::cerr)
+                     : nullptr;
     const ClosedLoopOutcome outcome = run_closed_loop(run, std::cerr);
     if (live) live->stop();
     if (outcome.interrupted) std::cerr << "avs demo: interrupted: partial report\n";

@@ -110,6 +110,10 @@ class ComponentContext {
   /// Wall time, or simulated time when the graph runs in sim time.
   virtual Time now() const = 0;
   virtual bool uses_sim_time() const = 0;
+  /// The DDS domain and partition of the container's graph: for a component that needs a
+  /// participant of its own (the live view's discovery, components/view).
+  virtual int dds_domain() const = 0;
+  virtual const std::string& dds_partition() const = 0;
 
   /// Calls `callback` every `period` of the context's clock, on the component's thread.
   virtual TimerId create_timer(Duration period, std::function<void()> callback) = 0;
