@@ -1,8 +1,11 @@
 // The `avs view` page in a real browser (issue 17): headless Chromium (Debian's, driven by
 // puppeteer-core) opens http://HOST:PORT/ while view_test_publisher runs, waits until the
 // page has drawn depth frames and poses, checks that the depth canvas is not blank (most
-// pixels coloured, both ends of the colour map present) and that the pose readout changes,
-// and saves a screenshot. Waits are for conditions, with generous timeouts.
+// pixels coloured, both ends of the colour map present, the target's centroid marked), that
+// the pose readout changes, that the pose error against /sim/ground_truth, the torques and the
+// stage times are shown with the publisher's values, and that the 3-D view (WebGL through
+// Chromium's software renderer) drew the scene and the model, and saves a screenshot. Waits are
+// for conditions, with generous timeouts.
 // usage: node check_page.mjs http://127.0.0.1:PORT/ SCREENSHOT.png [JOINT_STATES]
 // (JOINT_STATES: joint states the page must have drawn before the screenshot, default 200;
 // docs/img/view_page.png was taken during `avs demo --view` with 4000.)
@@ -20,8 +23,10 @@ async function main() {
     executablePath: chromium,
     headless: true,
     // Root in a container: no sandbox; no GPU on the test machines; a small /dev/shm.
-    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1280,900"],
-    defaultViewport: { width: 1280, height: 900 },
+    // WebGL (the 3-D panel) through SwiftShader, the software renderer.
+    args: ["--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--enable-unsafe-swiftshader",
+      "--window-size=1280,1400"],
+    defaultViewport: { width: 1280, height: 1400 },
     protocolTimeout: 20 * TIMEOUT_MS,
   });
   let failures = 0;
@@ -58,6 +63,56 @@ async function main() {
     console.log(`depth canvas: ${JSON.stringify(pixels)}`);
     check(pixels.coloured > 0.9 * pixels.total, "the depth canvas is not blank");
     check(pixels.red > 0 && pixels.blue > 0, "near (red) and far (blue) both drawn");
+
+    // The other panels, where the graph publishes their topics (view_test_publisher does).
+    const wantAll = process.env.AVS_PAGE_ALL_PANELS !== "0";
+    if (wantAll) {
+      await page.waitForFunction(
+        () => window.avsView.targetCount >= 3 && window.avsView.torqueCount >= 3 &&
+          window.avsView.errorCount >= 3 && window.avsView.timingCount >= 3 &&
+          window.avsView.sceneClouds >= 2 && window.avsView.modelClouds >= 2,
+        { timeout: TIMEOUT_MS, polling: 100 },
+      );
+      const text = (id) => page.$eval(id, (e) => e.textContent);
+      const target = await text("#target-readout");
+      const error = await text("#error-readout");
+      const timings = await text("#timings");
+      console.log(`target: ${target}\nerror: ${error}\ntimings:\n${timings}`);
+      check(/^centroid \(\d+\.0, \d+\.0\) px, mean depth 1\.250 m$/.test(target), "the centroid readout");
+      // The publisher's truth is the pose moved by 2 mm in x, same orientation.
+      check(error.includes("position 2.00 mm, orientation 0.00 deg"), "the pose error readout");
+      check(timings.includes("decode     median 0.750 ms  max 0.750 ms") &&
+        timings.includes("matching   median 0.500 ms"), "the stage times");
+      const green = await page.evaluate(() => {
+        const c = document.getElementById("depth");
+        const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) if (d[i + 1] > 200 && d[i] < 60 && d[i + 2] < 60) n++;
+        return n;
+      });
+      check(green > 0, `the centroid marked on the depth map (${green} green pixels)`);
+      const webgl = await page.evaluate(() => window.avsView.webgl);
+      check(webgl, "WebGL for the 3-D view");
+      if (webgl) {
+        const drawn = await page.evaluate(() => {
+          const src = document.getElementById("scene3d");
+          const c = document.createElement("canvas");
+          c.width = src.width;
+          c.height = src.height;
+          const ctx = c.getContext("2d");
+          ctx.drawImage(src, 0, 0);
+          const d = ctx.getImageData(0, 0, c.width, c.height).data;
+          let grey = 0, red = 0;
+          for (let i = 0; i < d.length; i += 4) {
+            if (d[i] > 120 && Math.abs(d[i] - d[i + 1]) < 20 && Math.abs(d[i] - d[i + 2]) < 20) grey++;
+            if (d[i] > 200 && d[i + 1] < 90 && d[i + 2] < 90) red++;
+          }
+          return { grey, red };
+        });
+        console.log(`3-D canvas: ${JSON.stringify(drawn)}`);
+        check(drawn.grey > 20 && drawn.red > 20, "the 3-D view shows scene points (grey) and the model (red)");
+      }
+    }
     const first = await page.$eval("#pose-readout", (e) => e.textContent);
     await page.waitForFunction(
       (before) => document.getElementById("pose-readout").textContent !== before,

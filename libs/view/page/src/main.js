@@ -1,11 +1,15 @@
 // The live page of `avs view` (docs/view.md): connects back to the server it came from with
 // the Foxglove WebSocket client, decodes the CDR messages with the advertised ros2msg
-// schemas, and draws the depth map, the pose and the head angles. Images are asked for at
-// most max_rate_hz (default 15; ?max_rate_hz=N in the page URL), which the server applies per
-// client. window.avsView holds counters for tests.
+// schemas, and draws the depth map with the target's centroid, the pose and its error against
+// the simulator's ground truth, the head angles and torques, the stage times and a 3-D view of
+// the scene points with the model. Images and clouds are asked for at most max_rate_hz
+// (default 15; ?max_rate_hz=N in the page URL), which the server applies per client.
+// window.avsView holds counters for tests.
 import {parse} from '@foxglove/rosmsg';
 import {MessageReader} from '@foxglove/rosmsg2-serialization';
 import {FoxgloveClient} from '@foxglove/ws-protocol';
+
+import {cloudPoints, Scene3d} from './scene3d.js';
 
 const WINDOW_S = 10;
 const state = (window.avsView = {
@@ -14,6 +18,14 @@ const state = (window.avsView = {
   poseCount: 0,
   jointCount: 0,
   diagnosticsCount: 0,
+  targetCount: 0,
+  torqueCount: 0,
+  truthCount: 0,
+  errorCount: 0,
+  timingCount: 0,
+  sceneClouds: 0,
+  modelClouds: 0,
+  webgl: false,
   channels: [],
 });
 
@@ -30,6 +42,12 @@ const handlers = {
   '/object/pose': onPose,
   '/head/joint_states': onJoints,
   '/diagnostics': onDiagnostics,
+  '/target': onTarget,
+  '/head/torque_command': onTorque,
+  '/sim/ground_truth': onTruth,
+  '/timing': onTiming,
+  '/object/scene_points': (m) => onCloud('scene', m),
+  '/object/model_points': (m) => onCloud('model', m),
 };
 const subscriptions = new Map();        // subscription id -> { reader, handler }
 const channelSubscription = new Map();  // channel id -> subscription id
@@ -126,12 +144,38 @@ function onDepth(m) {
   ctx.moveTo(m.width / 2, m.height / 2 - 6);
   ctx.lineTo(m.width / 2, m.height / 2 + 6);
   ctx.stroke();
+  drawCentroid(ctx, m.width, m.height);
   state.depthFrames++;
   $('depth-legend').textContent = Number.isFinite(lo) ?
       `${m.width}x${m.height}, ${lo.toFixed(3)} m (red) .. ${hi.toFixed(3)} m (blue), ` +
           `stamp ${stampS(m.header).toFixed(3)} s, frame ${m.header.frame_id}` :
       'no valid depth in the last image';
   setStatus();
+}
+
+// ---- /target: the image centroid (m10/m00, m01/m00) the head servoes to the image centre ----
+let lastTarget;
+
+function onTarget(m) {
+  state.targetCount++;
+  lastTarget = m;
+  const cx = m.centroid_x_px, cy = m.centroid_y_px;
+  $('target-readout').textContent = m.valid ?
+      `centroid (${cx.toFixed(1)}, ${cy.toFixed(1)}) px, mean depth ${
+          m.mean_depth_m.toFixed(3)} m` :
+      'no target in the last depth map';
+}
+
+/// A green circle at the last valid centroid, a line from the image centre to it.
+function drawCentroid(ctx, w, h) {
+  if (!lastTarget || !lastTarget.valid) return;
+  const cx = lastTarget.centroid_x_px, cy = lastTarget.centroid_y_px;
+  ctx.strokeStyle = '#0f0';
+  ctx.beginPath();
+  ctx.arc(cx, cy, 5, 0, 2 * Math.PI);
+  ctx.moveTo(w / 2, h / 2);
+  ctx.lineTo(cx, cy);
+  ctx.stroke();
 }
 
 function hue(h) {
@@ -208,6 +252,8 @@ function plot(canvas, series, labels, colors) {
 
 const poseSeries = new Series();
 const jointSeries = new Series();
+const torqueSeries = new Series();
+const errorSeries = new Series();
 
 function onPose(m) {
   const p = m.pose.position;
@@ -216,6 +262,7 @@ function onPose(m) {
   poseSeries.push(t, [p.x * 1e3, p.y * 1e3, p.z * 1e3]);
   state.poseCount++;
   state.lastPose = {t, p, q};
+  matchTruth(stampKey(m.header), {p, q}, undefined);
   $('pose-readout').textContent = `stamp ${t.toFixed(3)} s, frame ${m.header.frame_id}\n` +
       `position (mm)  x ${(p.x * 1e3).toFixed(2)}  y ${(p.y * 1e3).toFixed(2)}  z ${
                                       (p.z * 1e3).toFixed(2)}\n` +
@@ -232,6 +279,91 @@ function onJoints(m) {
   state.jointCount++;
 }
 
+function onTorque(m) {
+  const pan = m.name.indexOf('pan');
+  const tilt = m.name.indexOf('tilt');
+  if (pan < 0 || tilt < 0) return;
+  torqueSeries.push(stampS(m.header), [m.torque_nm[pan], m.torque_nm[tilt]]);
+  state.torqueCount++;
+}
+
+// ---- the pose error against /sim/ground_truth (pose_camera), by equal stamps ----
+const stampKey = (header) => `${header.stamp.sec}.${header.stamp.nanosec}`;
+const pendingPoses = new Map();   // stamp -> pose without its truth yet
+const pendingTruths = new Map();  // stamp -> truth without its pose yet
+const PENDING = 500;
+
+function onTruth(m) {
+  state.truthCount++;
+  matchTruth(
+      stampKey(m.header), undefined, {p: m.pose_camera.position, q: m.pose_camera.orientation});
+}
+
+function matchTruth(key, pose, truth) {
+  if (pose) {
+    truth = pendingTruths.get(key);
+    if (!truth) return remember(pendingPoses, key, pose);
+    pendingTruths.delete(key);
+  } else {
+    pose = pendingPoses.get(key);
+    if (!pose) return remember(pendingTruths, key, truth);
+    pendingPoses.delete(key);
+  }
+  const dp = Math.hypot(pose.p.x - truth.p.x, pose.p.y - truth.p.y, pose.p.z - truth.p.z) * 1e3;
+  const dot = Math.abs(
+      pose.q.x * truth.q.x + pose.q.y * truth.q.y + pose.q.z * truth.q.z + pose.q.w * truth.q.w);
+  const deg = (2 * Math.acos(Math.min(1, dot)) * 180) / Math.PI;
+  const [sec, nanosec] = key.split('.').map(Number);
+  errorSeries.push(sec + nanosec * 1e-9, [dp, deg]);
+  state.errorCount++;
+  $('error-readout').textContent = `error against /sim/ground_truth: position ${
+      dp.toFixed(2)} mm, orientation ${deg.toFixed(2)} deg`;
+}
+
+function remember(map, key, value) {
+  map.set(key, value);
+  if (map.size > PENDING) map.delete(map.keys().next().value);  // oldest first
+}
+
+// ---- /timing: per stage, the median and the maximum of the last 200 processing times ----
+const stageTimes = new Map();  // stage -> recent processing_ms
+
+function onTiming(m) {
+  state.timingCount++;
+  if (!stageTimes.has(m.stage)) stageTimes.set(m.stage, []);
+  const times = stageTimes.get(m.stage);
+  times.push(m.processing_ms);
+  if (times.length > 200) times.shift();
+}
+
+function drawTimings() {
+  const rows = [...stageTimes.entries()].sort().map(([stage, times]) => {
+    const sorted = [...times].sort((a, b) => a - b);
+    const median = sorted[Math.floor(sorted.length / 2)];
+    return `${stage.padEnd(10)} median ${median.toFixed(3)} ms  max ${
+        sorted[sorted.length - 1].toFixed(3)} ms  (last ${sorted.length}, wall clock)`;
+  });
+  if (rows.length > 0) $('timings').textContent = rows.join('\n');
+}
+
+// ---- 3-D: the S-PCD and the model at its pose ----
+const scene3d = new Scene3d($('scene3d'), $('scene3d-note'));
+state.webgl = scene3d.ok;
+
+function onCloud(which, m) {
+  const xyz = cloudPoints(m);
+  if (!xyz) return;
+  scene3d.set(which, xyz);
+  if (which === 'scene')
+    state.sceneClouds++;
+  else
+    state.modelClouds++;
+  if (scene3d.ok) {
+    $('scene3d-note').textContent = `${m.header.frame_id}: scene points grey, model red ` +
+        `(stamp ${stampS(m.header).toFixed(3)} s); drag to orbit, wheel to zoom`;
+  }
+}
+
 function onDiagnostics(m) {
   state.diagnosticsCount++;
   const lines = m.status.map(
@@ -243,6 +375,10 @@ function onDiagnostics(m) {
 function frame() {
   plot($('pose-plot'), poseSeries, ['x', 'y', 'z'], ['#d33', '#3a3', '#33d']);
   plot($('joint-plot'), jointSeries, ['pan', 'tilt'], ['#d33', '#33d']);
+  plot($('torque-plot'), torqueSeries, ['pan', 'tilt'], ['#d33', '#33d']);
+  plot($('error-plot'), errorSeries, ['mm', 'deg'], ['#d33', '#33d']);
+  drawTimings();
+  scene3d.draw();
   requestAnimationFrame(frame);
 }
 requestAnimationFrame(frame);
