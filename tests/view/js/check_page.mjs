@@ -125,6 +125,30 @@ async function main() {
     // Let the plots fill a little before the picture.
     await page.waitForFunction((n) => window.avsView.jointCount >= n, { timeout: 10 * TIMEOUT_MS },
       Number(jointStates));
+    // The time plots (uPlot): each drew coloured lines on its canvas.
+    const lines = await page.evaluate(() =>
+      ["pose-plot", "error-plot", "joint-plot", "torque-plot"].map((id) => {
+        const c = document.querySelector(`#${id} canvas`);
+        if (!c) return [id, -1];
+        const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          if (Math.max(d[i], d[i + 1], d[i + 2]) - Math.min(d[i], d[i + 1], d[i + 2]) > 100) n++;
+        }
+        return [id, n];
+      }));
+    console.log(`plot line pixels: ${JSON.stringify(lines)}`);
+    for (const [id, n] of lines) {
+      const want = id === "pose-plot" || id === "joint-plot" || wantAll;
+      if (want) check(n > 50, `the ${id} drew its lines (${n} coloured pixels)`);
+    }
+    // /diagnostics with the container's figures for each component.
+    await page.waitForFunction(() => window.avsView.diagnosticsCount >= 1,
+      { timeout: TIMEOUT_MS, polling: 100 });
+    const diagnostics = await page.$eval("#diagnostics", (e) => e.textContent);
+    console.log(`diagnostics:\n${diagnostics}`);
+    check(/: active \(\d+\.\d Hz, mean \d+\.\d{3} ms, max \d+\.\d{3} ms\)/.test(diagnostics),
+      "the diagnostics panel gives each component's rate and callback times");
     await page.screenshot({ path: screenshot });
     console.log(`screenshot: ${screenshot}`);
   } finally {

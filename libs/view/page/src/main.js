@@ -10,8 +10,8 @@ import {MessageReader} from '@foxglove/rosmsg2-serialization';
 import {FoxgloveClient} from '@foxglove/ws-protocol';
 
 import {cloudPoints, Scene3d} from './scene3d.js';
+import {Series, TimePlot} from './timeplot.js';
 
-const WINDOW_S = 10;
 const state = (window.avsView = {
   connected: false,
   depthFrames: 0,
@@ -184,76 +184,35 @@ function hue(h) {
   return [255 * r, 255 * g, 255 * b];
 }
 
-// ---- time series over the last WINDOW_S seconds of message stamps ----
-class Series {
-  constructor() {
-    this.t = [];
-    this.v = [];
-  }
-  push(t, values) {
-    this.t.push(t);
-    this.v.push(values);
-    const start = t - WINDOW_S;
-    let k = 0;
-    while (k < this.t.length && this.t[k] < start) k++;
-    if (k > 0) {
-      this.t.splice(0, k);
-      this.v.splice(0, k);
-    }
-  }
-}
-
-function plot(canvas, series, labels, colors) {
-  const ctx = canvas.getContext('2d');
-  const w = canvas.width;
-  const h = canvas.height;
-  ctx.fillStyle = '#fff';
-  ctx.fillRect(0, 0, w, h);
-  if (series.t.length < 2) return;
-  let lo = Infinity;
-  let hi = -Infinity;
-  for (const values of series.v) {
-    for (const v of values) {
-      if (v < lo) lo = v;
-      if (v > hi) hi = v;
-    }
-  }
-  if (hi - lo < 1e-9) {
-    hi += 0.5;
-    lo -= 0.5;
-  }
-  const t1 = series.t[series.t.length - 1];
-  const t0 = t1 - WINDOW_S;
-  const left = 50;
-  const X = (t) => left + ((w - left - 5) * (t - t0)) / WINDOW_S;
-  const Y = (v) => h - 15 - ((h - 25) * (v - lo)) / (hi - lo);
-  ctx.fillStyle = '#444';
-  ctx.font = '11px sans-serif';
-  ctx.fillText(hi.toFixed(1), 2, 12);
-  ctx.fillText(lo.toFixed(1), 2, h - 15);
-  ctx.fillText(`-${WINDOW_S} s`, left, h - 2);
-  ctx.fillText('now', w - 30, h - 2);
-  labels.forEach((label, j) => {
-    ctx.strokeStyle = colors[j];
-    ctx.beginPath();
-    series.t.forEach((t, k) => {
-      const x = X(t);
-      const y = Y(series.v[k][j]);
-      if (k === 0)
-        ctx.moveTo(x, y);
-      else
-        ctx.lineTo(x, y);
-    });
-    ctx.stroke();
-    ctx.fillStyle = colors[j];
-    ctx.fillText(label, left + 10 + 60 * j, 12);
-  });
-}
-
 const poseSeries = new Series();
 const jointSeries = new Series();
 const torqueSeries = new Series();
 const errorSeries = new Series();
+const RGB = ['#d33', '#3a3', '#33d'];
+const plots = [
+  new TimePlot(
+      $('pose-plot'), poseSeries,
+      [
+        {label: 'x', color: RGB[0], scale: 'xy'}, {label: 'y', color: RGB[1], scale: 'xy'},
+        {label: 'z', color: RGB[2], scale: 'z'}
+      ],
+      {xy: 'x, y (mm)', z: 'z (mm)'}),
+  new TimePlot(
+      $('error-plot'), errorSeries,
+      [
+        {label: 'position', color: RGB[0], scale: 'mm'},
+        {label: 'orientation', color: RGB[2], scale: 'deg'}
+      ],
+      {mm: 'position (mm)', deg: 'orientation (deg)'}, {height: 160}),
+  new TimePlot(
+      $('joint-plot'), jointSeries,
+      [{label: 'pan', color: RGB[0], scale: 'deg'}, {label: 'tilt', color: RGB[2], scale: 'deg'}],
+      {deg: 'angle (deg)'}),
+  new TimePlot(
+      $('torque-plot'), torqueSeries,
+      [{label: 'pan', color: RGB[0], scale: 'nm'}, {label: 'tilt', color: RGB[2], scale: 'nm'}],
+      {nm: 'torque (N m)'}),
+];
 
 function onPose(m) {
   const p = m.pose.position;
@@ -366,17 +325,27 @@ function onCloud(which, m) {
 
 function onDiagnostics(m) {
   state.diagnosticsCount++;
+  // The container's per-component figures (runtime/src/container.cpp): callbacks per second
+  // of the graph's clock and the wall-clock time spent in them.
+  const figures = (s) => {
+    const v = new Map(s.values.map((kv) => [kv.key, kv.value]));
+    const parts = [];
+    if (v.has('rate_hz')) parts.push(`${Number(v.get('rate_hz')).toFixed(1)} Hz`);
+    if (v.has('callback_ms_mean'))
+      parts.push(`mean ${Number(v.get('callback_ms_mean')).toFixed(3)} ms`);
+    if (v.has('callback_ms_max'))
+      parts.push(`max ${Number(v.get('callback_ms_max')).toFixed(3)} ms`);
+    return parts.length ? ` (${parts.join(', ')})` : '';
+  };
   const lines = m.status.map(
-      (s) => `${['OK', 'WARN', 'ERROR', 'STALE'][s.level] ?? s.level} ${s.name}: ${s.message}`,
+      (s) => `${['OK', 'WARN', 'ERROR', 'STALE'][s.level] ?? s.level} ${s.name}: ${s.message}` +
+          figures(s),
   );
   $('diagnostics').textContent = lines.slice(0, 20).join('\n');
 }
 
 function frame() {
-  plot($('pose-plot'), poseSeries, ['x', 'y', 'z'], ['#d33', '#3a3', '#33d']);
-  plot($('joint-plot'), jointSeries, ['pan', 'tilt'], ['#d33', '#33d']);
-  plot($('torque-plot'), torqueSeries, ['pan', 'tilt'], ['#d33', '#33d']);
-  plot($('error-plot'), errorSeries, ['mm', 'deg'], ['#d33', '#33d']);
+  for (const p of plots) p.update();
   drawTimings();
   scene3d.draw();
   requestAnimationFrame(frame);
