@@ -142,13 +142,15 @@ async function main() {
       const want = id === "pose-plot" || id === "joint-plot" || wantAll;
       if (want) check(n > 50, `the ${id} drew its lines (${n} coloured pixels)`);
     }
-    // /diagnostics with the container's figures for each component.
-    await page.waitForFunction(() => window.avsView.diagnosticsCount >= 1,
-      { timeout: TIMEOUT_MS, polling: 100 });
+    // /diagnostics with the container's figures for each component (the first report may
+    // come before the components are active).
+    const figures = /: active \(\d+\.\d Hz, mean \d+\.\d{3} ms, max \d+\.\d{3} ms\)/;
+    const shown = await page.waitForFunction(
+      (re) => new RegExp(re).test(document.getElementById("diagnostics").textContent),
+      { timeout: TIMEOUT_MS, polling: 100 }, figures.source).then(() => true, () => false);
     const diagnostics = await page.$eval("#diagnostics", (e) => e.textContent);
     console.log(`diagnostics:\n${diagnostics}`);
-    check(/: active \(\d+\.\d Hz, mean \d+\.\d{3} ms, max \d+\.\d{3} ms\)/.test(diagnostics),
-      "the diagnostics panel gives each component's rate and callback times");
+    check(shown, "the diagnostics panel gives each component's rate and callback times");
     await page.screenshot({ path: screenshot });
     console.log(`screenshot: ${screenshot}`);
   } finally {
