@@ -5,8 +5,9 @@
 # runs CHECK against the server: client (check_view.mjs, the Foxglove client), component (the
 # same check against the `view` component inside tests/view/view_graph.yaml instead of `avs
 # view`), bag (a bag recorded from the publisher, which then stops, played by `avs bag play
-# --view`; check_bag_view.mjs) or page (check_page.mjs, the page in headless Chromium; its
-# screenshot is WORK_DIR/view_page.png).
+# --view`; check_bag_view.mjs), page (check_page.mjs, the page in headless Chromium; its
+# screenshot is WORK_DIR/view_page.png) or demo (the page during `avs demo --view`, the
+# lockstep closed loop, without the publisher; WORK_DIR/demo_page.png).
 # usage: run_view_check.sh SOURCE_DIR WORK_DIR AVS_BINARY PUBLISHER_BINARY CHECK
 # (DOMAIN: leased by tests/support/test_domain.sh)
 set -euo pipefail
@@ -30,9 +31,17 @@ cleanup() {
   wait 2>/dev/null || true
 }
 trap cleanup EXIT
-"$publisher" "$domain" > publisher.log 2>&1 &
-pids+=($!)
-if [ "$check" = bag ]; then
+if [ "$check" != demo ]; then
+  "$publisher" "$domain" > publisher.log 2>&1 &
+  pids+=($!)
+fi
+if [ "$check" = demo ]; then
+  # Long enough for the page under any load: the check ends it once the page has passed.
+  rm -rf demo_run
+  "$avs" demo --view --view-port 0 --seconds 30 --out demo_run > view.log 2>&1 &
+  pids+=($!)
+  view_log=view.log
+elif [ "$check" = bag ]; then
   rm -f view_check.mcap
   AVS_DOMAIN_ID="$domain" "$avs" bag record /object/pose /depth/image -o view_check.mcap \
     --duration 4 > record.log 2>&1
@@ -73,12 +82,18 @@ if [ -z "$port" ]; then
   exit 1
 fi
 status=0
-if [ "$check" = page ]; then
+if [ "$check" = page ] || [ "$check" = demo ]; then
   if [ ! -x "${AVS_CHROMIUM:-/usr/bin/chromium}" ]; then
     echo "FAILED: no chromium (bash tools/run.sh test installs Debian's chromium)" >&2
     exit 1
   fi
-  node check_page.mjs "http://127.0.0.1:$port/" "$work/view_page.png" || status=$?
+  if [ "$check" = page ]; then
+    node check_page.mjs "http://127.0.0.1:$port/" "$work/view_page.png" || status=$?
+  else
+    # The address the demo printed, with its page options (?object=ken).
+    url=$(sed -n 's|.*live view at \(http://[^ ]*\).*|\1|p' view.log | head -1)
+    AVS_PAGE_EXPECT=demo node check_page.mjs "$url" "$work/demo_page.png" 300 || status=$?
+  fi
 elif [ "$check" = bag ]; then
   node check_bag_view.mjs "ws://127.0.0.1:$port" || status=$?
 else

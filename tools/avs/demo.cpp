@@ -2,9 +2,11 @@
 // Gray-code depth at 500 Hz, active tracking by the pan/tilt head, model matching of the
 // kendama's ken on the manipulator trajectory) in sim-time lockstep, with progress, the
 // results table beside the paper's figures, and the report folder (figures, index.html).
+#include <cctype>
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include "avs/report/report.hpp"
 #include "avs/runtime/error.hpp"
@@ -21,6 +23,23 @@ std::filesystem::path default_run_dir(const std::string& name) {
   const std::time_t now = std::time(nullptr);
   std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", std::localtime(&now));
   return std::filesystem::path("avs-runs") / (name + "-" + stamp);
+}
+
+/// "object=NAME" for the page (docs/view.md): the error panel compares the pose with the
+/// /sim/ground_truth of that object, which is the run's object (as run_recorder's).
+std::string page_object_query(const std::string& object) {
+  static constexpr char kHex[] = "0123456789ABCDEF";
+  std::string query = "object=";
+  for (const unsigned char c : object) {
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~') {
+      query += static_cast<char>(c);
+    } else {  // percent-encoded (RFC 3986), e.g. a mesh file's path
+      query += '%';
+      query += kHex[c >> 4];
+      query += kHex[c & 15];
+    }
+  }
+  return query;
 }
 
 }  // namespace
@@ -65,7 +84,7 @@ void add_demo_command(Command& app) {
               << "); Ctrl-C ends it early with a partial report\n";
     const std::unique_ptr<view::View> live =
         view.enabled ? start_live_view(view, choose_closed_loop_domain(run, std::cerr), "",
-                                       "avs demo", std::cerr)
+                                       "avs demo", std::cerr, page_object_query(run.object))
                      : nullptr;
     const ClosedLoopOutcome outcome = run_closed_loop(run, std::cerr);
     if (live) live->stop();

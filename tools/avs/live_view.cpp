@@ -15,7 +15,7 @@ void add_live_view_options(Command* cmd, LiveViewFlags& flags, const std::string
 
 std::unique_ptr<view::View> start_live_view(const LiveViewFlags& flags, int domain,
                                             const std::string& partition, const std::string& who,
-                                            std::ostream& out) {
+                                            std::ostream& out, const std::string& page_query) {
   if (!flags.enabled) return nullptr;
   if (flags.port > 65535) throw runtime::Error(who + ": --view-port must be in [0, 65535]");
   view::ViewOptions o;
@@ -25,8 +25,9 @@ std::unique_ptr<view::View> start_live_view(const LiveViewFlags& flags, int doma
   o.server.web_root = view::built_page_dir();
   auto live = std::make_unique<view::View>(o);
   live->start();
-  out << who << ": live view at http://127.0.0.1:" << live->port()
-      << "/ (Foxglove: ws://127.0.0.1:" << live->port() << ", domain " << domain << ")";
+  out << who << ": live view at http://127.0.0.1:" << live->port() << "/"
+      << (page_query.empty() ? "" : "?" + page_query)
+      << " (Foxglove: ws://127.0.0.1:" << live->port() << ", domain " << domain << ")";
   if (o.server.web_root.empty()) out << "; NO PAGE: this build had no npm to bundle it";
   out << "\n" << std::flush;
   return live;

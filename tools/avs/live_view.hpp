@@ -22,10 +22,11 @@ struct LiveViewFlags {
 void add_live_view_options(Command* cmd, LiveViewFlags& flags, const std::string& what);
 
 /// The started server when flags.enabled, else nullptr. Prints "<who>: live view at
-/// http://127.0.0.1:PORT/ (Foxglove: ws://127.0.0.1:PORT)" to `out`. Throws runtime::Error
-/// for a port out of range or one that cannot be opened.
+/// http://127.0.0.1:PORT/?PAGE_QUERY (Foxglove: ws://127.0.0.1:PORT)" to `out`; page_query
+/// is e.g. "object=ken" (the page's options, docs/view.md), empty for none. Throws
+/// runtime::Error for a port out of range or one that cannot be opened.
 std::unique_ptr<view::View> start_live_view(const LiveViewFlags& flags, int domain,
                                             const std::string& partition, const std::string& who,
-                                            std::ostream& out);
+                                            std::ostream& out, const std::string& page_query = "");
 
 }  // namespace avs::cli

@@ -136,13 +136,15 @@ function onDepth(m) {
     image.data[4 * i + 3] = 255;
   }
   ctx.putImageData(image, 0, 0);
-  // The image centre (cross).
+  // The image centre (cross), sized with the image so that it shows at 160 and 512 px.
+  const arm = Math.max(6, m.width / 40);
+  ctx.lineWidth = Math.max(1, m.width / 256);
   ctx.strokeStyle = '#fff';
   ctx.beginPath();
-  ctx.moveTo(m.width / 2 - 6, m.height / 2);
-  ctx.lineTo(m.width / 2 + 6, m.height / 2);
-  ctx.moveTo(m.width / 2, m.height / 2 - 6);
-  ctx.lineTo(m.width / 2, m.height / 2 + 6);
+  ctx.moveTo(m.width / 2 - arm, m.height / 2);
+  ctx.lineTo(m.width / 2 + arm, m.height / 2);
+  ctx.moveTo(m.width / 2, m.height / 2 - arm);
+  ctx.lineTo(m.width / 2, m.height / 2 + arm);
   ctx.stroke();
   drawCentroid(ctx, m.width, m.height);
   state.depthFrames++;
@@ -172,7 +174,7 @@ function drawCentroid(ctx, w, h) {
   const cx = lastTarget.centroid_x_px, cy = lastTarget.centroid_y_px;
   ctx.strokeStyle = '#0f0';
   ctx.beginPath();
-  ctx.arc(cx, cy, 5, 0, 2 * Math.PI);
+  ctx.arc(cx, cy, Math.max(5, w / 50), 0, 2 * Math.PI);
   ctx.moveTo(w / 2, h / 2);
   ctx.lineTo(cx, cy);
   ctx.stroke();
@@ -252,8 +254,29 @@ const pendingPoses = new Map();   // stamp -> pose without its truth yet
 const pendingTruths = new Map();  // stamp -> truth without its pose yet
 const PENDING = 500;
 
+// /sim/ground_truth has one message per scene object (the target, the wall, ...): the pose is
+// compared with the object named by ?object=NAME in the page URL (`avs demo --view` prints
+// it), or with the only object there is; with several and no name the panel lists them.
+const truthObjects = new Set();
+const wantedObject = params.get('object');
+
 function onTruth(m) {
   state.truthCount++;
+  const name = m.object_name;
+  if (!truthObjects.has(name)) {
+    truthObjects.add(name);
+    if (!wantedObject && truthObjects.size > 1) {
+      pendingTruths.clear();
+      errorSeries.clear();
+    }
+  }
+  const compared = wantedObject ?? (truthObjects.size === 1 ? name : undefined);
+  if (compared === undefined) {
+    $('error-readout').textContent = `/sim/ground_truth has several objects (${
+            [...truthObjects].join(', ')}): open the page with ?object=NAME to compare with one`;
+    return;
+  }
+  if (name !== compared) return;
   matchTruth(
       stampKey(m.header), undefined, {p: m.pose_camera.position, q: m.pose_camera.orientation});
 }
@@ -275,8 +298,9 @@ function matchTruth(key, pose, truth) {
   const [sec, nanosec] = key.split('.').map(Number);
   errorSeries.push(sec + nanosec * 1e-9, [dp, deg]);
   state.errorCount++;
-  $('error-readout').textContent = `error against /sim/ground_truth: position ${
-      dp.toFixed(2)} mm, orientation ${deg.toFixed(2)} deg`;
+  $('error-readout').textContent = `error against /sim/ground_truth of ${wantedObject ?? [
+    ...truthObjects
+  ][0]}: position ${dp.toFixed(2)} mm, orientation ${deg.toFixed(2)} deg`;
 }
 
 function remember(map, key, value) {
@@ -323,6 +347,8 @@ function onCloud(which, m) {
   }
 }
 
+const diagnosticLines = new Map();  // status name -> its latest line
+
 function onDiagnostics(m) {
   state.diagnosticsCount++;
   // The container's per-component figures (runtime/src/container.cpp): callbacks per second
@@ -337,11 +363,15 @@ function onDiagnostics(m) {
       parts.push(`max ${Number(v.get('callback_ms_max')).toFixed(3)} ms`);
     return parts.length ? ` (${parts.join(', ')})` : '';
   };
-  const lines = m.status.map(
-      (s) => `${['OK', 'WARN', 'ERROR', 'STALE'][s.level] ?? s.level} ${s.name}: ${s.message}` +
-          figures(s),
-  );
-  $('diagnostics').textContent = lines.slice(0, 20).join('\n');
+  // Each container (and the server) publishes its own array: keep the latest line per name.
+  for (const s of m.status) {
+    diagnosticLines.set(
+        s.name,
+        `${['OK', 'WARN', 'ERROR', 'STALE'][s.level] ?? s.level} ${s.name}: ${s.message}` +
+            figures(s));
+  }
+  const names = [...diagnosticLines.keys()].sort();
+  $('diagnostics').textContent = names.slice(0, 40).map((n) => diagnosticLines.get(n)).join('\n');
 }
 
 function frame() {

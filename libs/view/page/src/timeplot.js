@@ -25,6 +25,11 @@ export class Series {
     }
     this.changed = true;
   }
+  clear() {
+    this.t = [];
+    this.v = [];
+    this.changed = true;
+  }
 }
 
 const fixed = (digits) => (u, v) => (v == null ? '-' : v.toFixed(digits));
