@@ -7,8 +7,8 @@
 // plots, /diagnostics), and saves a screenshot. Waits are for conditions, with generous
 // timeouts.
 // AVS_PAGE_EXPECT says what runs: "publisher" (default: view_test_publisher, whose values
-// are known exactly), "demo" (`avs demo --view`: the lockstep closed loop of the ken, values
-// checked for form and plausibility) or "depth" (only depth, poses and joints).
+// are known exactly) or "demo" (`avs demo --view`: the lockstep closed loop of the ken, values
+// checked for form and plausibility).
 // usage: node check_page.mjs http://127.0.0.1:PORT/ SCREENSHOT.png [JOINT_STATES]
 // (JOINT_STATES: joint states the page must have drawn before the screenshot, default 200.)
 import { createRequire } from "node:module";
@@ -66,69 +66,66 @@ async function main() {
     check(pixels.coloured > 0.9 * pixels.total, "the depth canvas is not blank");
     check(pixels.red > 0 && pixels.blue > 0, "near (red) and far (blue) both drawn");
 
-    // The other panels, where the graph publishes their topics (view_test_publisher does).
+    // The other panels.
     const expect = process.env.AVS_PAGE_EXPECT ?? "publisher";
-    check(["publisher", "demo", "depth"].includes(expect), `AVS_PAGE_EXPECT=${expect} is known`);
-    const wantAll = expect !== "depth";
+    check(["publisher", "demo"].includes(expect), `AVS_PAGE_EXPECT=${expect} is known`);
     const exact = expect === "publisher";
-    if (wantAll) {
-      await page.waitForFunction(
-        () => window.avsView.targetCount >= 3 && window.avsView.torqueCount >= 3 &&
-          window.avsView.errorCount >= 3 && window.avsView.timingCount >= 3 &&
-          window.avsView.sceneClouds >= 2 && window.avsView.modelClouds >= 2,
-        { timeout: TIMEOUT_MS, polling: 100 },
-      );
-      const text = (id) => page.$eval(id, (e) => e.textContent);
-      const target = await text("#target-readout");
-      const error = await text("#error-readout");
-      const timings = await text("#timings");
-      console.log(`target: ${target}\nerror: ${error}\ntimings:\n${timings}`);
-      if (exact) {
-        check(/^centroid \(\d+\.0, \d+\.0\) px, mean depth 1\.250 m$/.test(target), "the centroid readout");
-        // The publisher's truth is the pose moved by 2 mm in x, same orientation.
-        check(error.includes("position 2.00 mm, orientation 0.00 deg"), "the pose error readout");
-        check(timings.includes("decode     median 0.750 ms  max 0.750 ms") &&
-          timings.includes("matching   median 0.500 ms"), "the stage times");
-      } else {
-        // The ken at about 1 m (launch_config/scenes/manipulator_ken.yaml), compared with its
-        // own truth (?object=ken from the demo's address), every stage of the loop timed.
-        const centroid = /^centroid \((\d+\.\d), (\d+\.\d)\) px, mean depth (\d+\.\d{3}) m$/.exec(target);
-        check(centroid && Number(centroid[3]) > 0.5 && Number(centroid[3]) < 2.5, "the centroid readout");
-        check(/^error against \/sim\/ground_truth of ken: position \d+\.\d\d mm, orientation \d+\.\d\d deg$/
-          .test(error), "the pose error readout names the object and gives both errors");
-        for (const stage of ["decode", "matching", "tracking"]) {
-          check(new RegExp(`^${stage} +median \\d+\\.\\d{3} ms`, "m").test(timings), `the ${stage} stage time`);
+    await page.waitForFunction(
+      () => window.avsView.targetCount >= 3 && window.avsView.torqueCount >= 3 &&
+        window.avsView.errorCount >= 3 && window.avsView.timingCount >= 3 &&
+        window.avsView.sceneClouds >= 2 && window.avsView.modelClouds >= 2,
+      { timeout: TIMEOUT_MS, polling: 100 },
+    );
+    const text = (id) => page.$eval(id, (e) => e.textContent);
+    const target = await text("#target-readout");
+    const error = await text("#error-readout");
+    const timings = await text("#timings");
+    console.log(`target: ${target}\nerror: ${error}\ntimings:\n${timings}`);
+    if (exact) {
+      check(/^centroid \(\d+\.0, \d+\.0\) px, mean depth 1\.250 m$/.test(target), "the centroid readout");
+      // The publisher's truth is the pose moved by 2 mm in x, same orientation.
+      check(error.includes("position 2.00 mm, orientation 0.00 deg"), "the pose error readout");
+      check(timings.includes("decode     median 0.750 ms  max 0.750 ms") &&
+        timings.includes("matching   median 0.500 ms"), "the stage times");
+    } else {
+      // The ken at about 1 m (launch_config/scenes/manipulator_ken.yaml), compared with its
+      // own truth (?object=ken from the demo's address), every stage of the loop timed.
+      const centroid = /^centroid \((\d+\.\d), (\d+\.\d)\) px, mean depth (\d+\.\d{3}) m$/.exec(target);
+      check(centroid && Number(centroid[3]) > 0.5 && Number(centroid[3]) < 2.5, "the centroid readout");
+      check(/^error against \/sim\/ground_truth of ken: position \d+\.\d\d mm, orientation \d+\.\d\d deg$/
+        .test(error), "the pose error readout names the object and gives both errors");
+      for (const stage of ["decode", "matching", "tracking"]) {
+        check(new RegExp(`^${stage} +median \\d+\\.\\d{3} ms`, "m").test(timings), `the ${stage} stage time`);
+      }
+    }
+    const green = await page.evaluate(() => {
+      const c = document.getElementById("depth");
+      const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i + 1] > 200 && d[i] < 60 && d[i + 2] < 60) n++;
+      return n;
+    });
+    check(green > 0, `the centroid marked on the depth map (${green} green pixels)`);
+    const webgl = await page.evaluate(() => window.avsView.webgl);
+    check(webgl, "WebGL for the 3-D view");
+    if (webgl) {
+      const drawn = await page.evaluate(() => {
+        const src = document.getElementById("scene3d");
+        const c = document.createElement("canvas");
+        c.width = src.width;
+        c.height = src.height;
+        const ctx = c.getContext("2d");
+        ctx.drawImage(src, 0, 0);
+        const d = ctx.getImageData(0, 0, c.width, c.height).data;
+        let grey = 0, red = 0;
+        for (let i = 0; i < d.length; i += 4) {
+          if (d[i] > 120 && Math.abs(d[i] - d[i + 1]) < 20 && Math.abs(d[i] - d[i + 2]) < 20) grey++;
+          if (d[i] > 200 && d[i + 1] < 90 && d[i + 2] < 90) red++;
         }
-      }
-      const green = await page.evaluate(() => {
-        const c = document.getElementById("depth");
-        const d = c.getContext("2d").getImageData(0, 0, c.width, c.height).data;
-        let n = 0;
-        for (let i = 0; i < d.length; i += 4) if (d[i + 1] > 200 && d[i] < 60 && d[i + 2] < 60) n++;
-        return n;
+        return { grey, red };
       });
-      check(green > 0, `the centroid marked on the depth map (${green} green pixels)`);
-      const webgl = await page.evaluate(() => window.avsView.webgl);
-      check(webgl, "WebGL for the 3-D view");
-      if (webgl) {
-        const drawn = await page.evaluate(() => {
-          const src = document.getElementById("scene3d");
-          const c = document.createElement("canvas");
-          c.width = src.width;
-          c.height = src.height;
-          const ctx = c.getContext("2d");
-          ctx.drawImage(src, 0, 0);
-          const d = ctx.getImageData(0, 0, c.width, c.height).data;
-          let grey = 0, red = 0;
-          for (let i = 0; i < d.length; i += 4) {
-            if (d[i] > 120 && Math.abs(d[i] - d[i + 1]) < 20 && Math.abs(d[i] - d[i + 2]) < 20) grey++;
-            if (d[i] > 200 && d[i + 1] < 90 && d[i + 2] < 90) red++;
-          }
-          return { grey, red };
-        });
-        console.log(`3-D canvas: ${JSON.stringify(drawn)}`);
-        check(drawn.grey > 20 && drawn.red > 20, "the 3-D view shows scene points (grey) and the model (red)");
-      }
+      console.log(`3-D canvas: ${JSON.stringify(drawn)}`);
+      check(drawn.grey > 20 && drawn.red > 20, "the 3-D view shows scene points (grey) and the model (red)");
     }
     const first = await page.$eval("#pose-readout", (e) => e.textContent);
     await page.waitForFunction(
@@ -155,10 +152,7 @@ async function main() {
         return [id, n];
       }));
     console.log(`plot line pixels: ${JSON.stringify(lines)}`);
-    for (const [id, n] of lines) {
-      const want = id === "pose-plot" || id === "joint-plot" || wantAll;
-      if (want) check(n > 50, `the ${id} drew its lines (${n} coloured pixels)`);
-    }
+    for (const [id, n] of lines) check(n > 50, `the ${id} drew its lines (${n} coloured pixels)`);
     // /diagnostics with the container's figures for each component (the first report may
     // come before the components are active).
     const figures = /: active \(\d+\.\d Hz, mean \d+\.\d{3} ms, max \d+\.\d{3} ms\)/;

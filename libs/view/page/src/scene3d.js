@@ -51,6 +51,9 @@ export class Scene3d {
     this.controls = new OrbitControls(this.camera, canvas);
     this.controls.target.set(0, 0, 1);
     this.controls.update();
+    // Rendered only when something changed: a software WebGL renderer costs a browser core.
+    this.dirty = true;
+    this.controls.addEventListener('change', () => (this.dirty = true));
     // The camera frame's axes: x orange, y green, z blue (red is the model's).
     const axes = new THREE.AxesHelper(0.1);
     axes.setColors(0xffaa00, 0x00ff00, 0x4080ff);
@@ -77,6 +80,7 @@ export class Scene3d {
     const cloud = this.clouds[which];
     cloud.geometry.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
     cloud.geometry.computeBoundingSphere();
+    this.dirty = true;
     if (!this.framed && which === 'scene' && xyz.length >= 3) {
       // Aim once at the first scene cloud, from slightly above the optical centre's line of
       // sight and near enough that the cloud fills about half the view; the user's orbit is
@@ -93,7 +97,10 @@ export class Scene3d {
     }
   }
 
+  /// Renders if a cloud or the view changed since the last call.
   draw() {
-    if (this.ok) this.renderer.render(this.scene, this.camera);
+    if (!this.ok || !this.dirty) return;
+    this.dirty = false;
+    this.renderer.render(this.scene, this.camera);
   }
 }
