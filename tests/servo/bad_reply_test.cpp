@@ -23,8 +23,8 @@
 namespace avs::servo {
 namespace {
 
-constexpr double rate_hz = 20.0;
-constexpr double period_s = 1.0 / rate_hz;
+constexpr double exchange_rate_hz = 20.0;
+constexpr double exchange_period_s = 1.0 / exchange_rate_hz;
 
 enum class Corruption : int {
   none,
@@ -188,14 +188,14 @@ class BadReplyTest : public ::testing::TestWithParam<Corruption> {
     AmplifierServerConfig server_config;
     for (auto& axis : server_config.axes) axis.watchdog_timeout_s = 0;  // isolate the host side
     server_ = std::make_unique<AmplifierServer>(server_config);
-    server_->step(period_s);
+    server_->step(exchange_period_s);
     proxy_ = std::make_unique<CorruptingProxy>(server_->port());
     DriveClientConfig c = default_drive_client_config("127.0.0.1", proxy_->port());
-    c.cycle_rate_hz = rate_hz;
+    c.cycle_rate_hz = exchange_rate_hz;
     c.response_timeout_s = 0.02;
-    c.command_freshness.timeout_s = 3 * period_s;
-    c.reconnect_backoff_initial_s = period_s;
-    c.reconnect_backoff_max_s = 2 * period_s;
+    c.command_freshness.timeout_s = 3 * exchange_period_s;
+    c.reconnect_backoff_initial_s = exchange_period_s;
+    c.reconnect_backoff_max_s = 2 * exchange_period_s;
     client_ = std::make_unique<DriveClient>(c);
     client_->connect();
     client_->activate(t_);
@@ -203,10 +203,10 @@ class BadReplyTest : public ::testing::TestWithParam<Corruption> {
   }
 
   CycleResult cycle() {
-    t_ += period_s;
+    t_ += exchange_period_s;
     client_->set_command({1.0, 0.1}, t_, t_);
     CycleResult r = client_->cycle(t_);
-    server_->step(period_s);
+    server_->step(exchange_period_s);
     return r;
   }
 
@@ -241,7 +241,7 @@ TEST_P(BadReplyTest, InAConfigurationReadOrWriteFailsTheConnect) {
   for (const std::uint8_t function : {std::uint8_t{0x03}, std::uint8_t{0x10}}) {
     SCOPED_TRACE("function " + std::to_string(function));
     DriveClientConfig c = default_drive_client_config("127.0.0.1", proxy_->port());
-    c.cycle_rate_hz = rate_hz;
+    c.cycle_rate_hz = exchange_rate_hz;
     c.response_timeout_s = 0.02;
     DriveClient fresh(c);
     const int before = proxy_->corrupted_replies();

@@ -12,8 +12,6 @@
 namespace avs::sim {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 TEST(Head, ZeroAnglesLookAlongWorldXWithCameraOffsetA) {
   HeadConfig head;
   head.p_tilt_camera_m = Eigen::Vector3d(0.05, 0, 0);
@@ -48,7 +46,7 @@ TEST(Head, PositivePanTurnsRightPositiveTiltLooksDownAndTheOffsetSwingsWithThem)
   // image +x (world -Y at home), positive tilt toward image +y (down).
   HeadConfig head;
   head.p_tilt_camera_m = Eigen::Vector3d(0.05, 0, 0);
-  const Eigen::Isometry3d pan = T_world_camera(head, kPi / 2, 0);
+  const Eigen::Isometry3d pan = T_world_camera(head, std::numbers::pi / 2, 0);
   EXPECT_TRUE(pan.linear().col(2).isApprox(-Eigen::Vector3d::UnitY()));
   EXPECT_TRUE(pan.translation().isApprox(Eigen::Vector3d(0, -0.05, 0)));
   const Eigen::Isometry3d tilt = T_world_camera(head, 0, 0.3);
