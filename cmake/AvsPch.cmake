@@ -12,9 +12,11 @@ set(CMAKE_UNITY_BUILD_BATCH_SIZE 32 CACHE STRING "Sources per unity batch")
 # parse (REUSE_FROM) instead of parsing them again in each of its compiler runs. Only headers that
 # do not change with our code go in, so an edit of ours never rebuilds the PCH.
 #
-# GCC accepts a PCH only from a compiler run with the same -fpie/-fPIC setting (-O levels and
-# definitions of our own may differ), hence one host per kind of target. A PCH that GCC refuses
-# is a -Winvalid-pch warning, an error under AVS_WERROR, so CI would notice a mismatch.
+# GCC accepts a PCH only from a compiler run with the same -fpie/-fPIC setting and the same
+# predefined macros (definitions of our own may differ), hence one host per kind of target. A PCH
+# that GCC refuses is a -Winvalid-pch warning, an error under AVS_WERROR, so CI notices a
+# mismatch. It pays in the test build, not in the demo's (docs/build.md): tools/run.sh demo
+# turns it off.
 option(AVS_PCH "Share precompiled system headers across targets (GCC)" ON)
 
 set(AVS_PCH_HEADERS
@@ -41,7 +43,8 @@ function(_avs_pch_host name pic glue test)
   target_precompile_headers(${name} PRIVATE ${headers})
   # -Wpedantic changes predefined macros (__cpp_runtime_arrays): the host compiles with the
   # project's warning flags, and only targets that have them reuse its PCH. The -O level is
-  # the user's too: a PCH's inline functions keep the optimisation of the run that made it.
+  # the user's too: -O1 test files reusing a -O3 PCH gave GCC 12 -Wstringop-overflow warnings
+  # (graph_test.cpp) that they do not give with their own -O1.
   avs_apply_warnings(${name})
   if(glue)
     avs_glue_code(${name})
@@ -102,6 +105,7 @@ function(avs_precompile_headers)
       set(pic OFF)
     endif()
     set(glue OFF)
+    # avs_glue_code() adds -O1 to a target's own options.
     if(options MATCHES "-O1")
       string(APPEND host _o1)
       set(glue ON)

@@ -7,7 +7,7 @@ function(avs_apply_warnings target)
     # (the fuzz build) has no such option.
     $<$<CXX_COMPILER_ID:GNU>:-Wno-restrict>
     # ... and false -Wstringop-overread positives for std::string::find once it is inlined
-    # into a larger unity batch (bench::option_words; GCC bug 106199).
+    # into a larger unity batch (bench::option_words in the runtime's batch).
     $<$<CXX_COMPILER_ID:GNU>:-Wno-stringop-overread>)
   # A unity build includes .cpp files into one another: GCC then reports types of a file's
   # anonymous namespace used by its own classes as if they came from a header.
