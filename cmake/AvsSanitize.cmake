@@ -9,6 +9,11 @@ if(AVS_SANITIZE)
     message(FATAL_ERROR "AVS_SANITIZE='${AVS_SANITIZE}': use address,undefined, address, undefined or thread")
   endif()
   add_compile_options(-fsanitize=${AVS_SANITIZE} -fno-omit-frame-pointer -g1)
+  # A Release sanitizer build is compiled at -O1, as ASan's documentation advises for a usable
+  # speed: -O3 adds compile time (CI builds the plain tree and this one) and the checks are the same.
+  # The speed figures come from the plain build, never from this one.
+  set(CMAKE_C_FLAGS_RELEASE "-O1 -DNDEBUG")
+  set(CMAKE_CXX_FLAGS_RELEASE "-O1 -DNDEBUG")
   if(AVS_SANITIZE MATCHES "undefined")
     add_compile_options(-fno-sanitize-recover=undefined)
   endif()
@@ -17,6 +22,13 @@ if(AVS_SANITIZE)
     # uses (the `avs view` server); that is a warning about TSan's coverage, not about our code,
     # and must not fail an AVS_WERROR build.
     add_compile_options(-Wno-error=tsan)
+  endif()
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+    # Instrumented code changes GCC's flow analysis: with ASan + UBSan, GCC 12 reports
+    # std::function members inside libstdc++'s std::regex as maybe-uninitialized
+    # (mcap_malformed_test, seen 2026-12-04). The uninstrumented build keeps that warning as an
+    # error, so nothing is lost by not asking it of the instrumented one.
+    add_compile_options(-Wno-maybe-uninitialized)
   endif()
   add_link_options(-fsanitize=${AVS_SANITIZE})
   # The clang fuzz sub-build has its own sanitizers; not twice.

@@ -135,6 +135,7 @@ TEST_F(DeploymentTest, CycloneAcceptsTheGeneratedConfig) {
   d.hosts[0].interface = "lo";
   for (bool multicast : {false, true}) {
     d.discovery.multicast = multicast;
+    d.transport.receive_buffer_bytes = multicast ? 0 : 262144;  // Sizing/ReceiveBufferSize too
     const std::string xml = cyclone_config(d, d.hosts[0], "talkers");
     const dds_domainid_t id = multicast ? 188 : 189;
     const dds_entity_t domain = dds_create_domain(id, xml.c_str());
@@ -226,6 +227,29 @@ TEST_F(DeploymentTest, UnknownKeyAndBadValues) {
   EXPECT_EQ(where(3), "5:1") << r.errors[3].str();   // unknown key
   EXPECT_NE(r.errors[3].str().find("did you mean 'hosts'"), std::string::npos) << r.errors[3].str();
   EXPECT_EQ(where(4), "7:12") << r.errors[4].str();  // host name starts with a digit
+}
+
+TEST_F(DeploymentTest, ReceiveBufferSizeIsCheckedAndReachesCyclone) {
+  // Below Cyclone's largest message chunk twice over: refused at its value, with the bound.
+  const std::string e =
+      single_error(std::string(kTwoHosts) + "transport: {receive_buffer_bytes: 1000}\n");
+  EXPECT_NE(e.find("deploy.yaml:12:"), std::string::npos) << e;
+  EXPECT_NE(e.find("below 262144"), std::string::npos) << e;
+  LoadResult r = load_deployment(
+      write("deploy.yaml", std::string(kTwoHosts) + "transport: {receive_buffer_bytes: 524288}\n"),
+      {});
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.deployment->transport.receive_buffer_bytes, 524288u);
+  const std::string xml = cyclone_config(*r.deployment, r.deployment->hosts[0], "talkers");
+  EXPECT_NE(xml.find("<Sizing><ReceiveBufferSize>524288B</ReceiveBufferSize></Sizing>"),
+            std::string::npos)
+      << xml;
+  // Not given: Cyclone's own default, no element.
+  LoadResult plain = load_deployment(write("deploy.yaml", kTwoHosts), {});
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(
+      cyclone_config(*plain.deployment, plain.deployment->hosts[0], "talkers").find("<Sizing>"),
+      std::string::npos);
 }
 
 TEST_F(DeploymentTest, GraphErrorsAreReportedWithTheGraphFile) {

@@ -18,6 +18,7 @@ bad = []
 for c in ["world", "vision", "control", "drive", "matcher", "recorder"]:
     if not r[f"container.{c}.samples"] >= 15: bad.append(f"{c} sampled after the warm-up")
     if r[f"container.{c}.rss_kib_per_min"] is None: bad.append(f"{c}: a memory slope")
+    if r[f"container.{c}.rss_peak_kib_growth_between_halves"] is None: bad.append(f"{c}: a peak growth")
     if r[f"container.{c}.fds_end"] is None or r[f"container.{c}.fds_end"] <= 0: bad.append(f"{c}: descriptors read")
 if r["container_restarts"] != 0: bad.append("no container restarted")
 if not r["pose_rate_hz"] > 0: bad.append("poses after the warm-up")

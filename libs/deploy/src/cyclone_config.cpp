@@ -87,6 +87,10 @@ std::string cyclone_config(const Deployment& d, const Host& host, const std::str
     << "<SocketReceiveBufferSize min=\"default\" max=\"" << window << "B\"/>"
     << "<SocketSendBufferSize min=\"default\" max=\"" << std::min<std::uint64_t>(window, 4u << 20)
     << "B\"/></Internal>";
+  if (d.transport.receive_buffer_bytes > 0) {
+    x << "<Sizing><ReceiveBufferSize>" << d.transport.receive_buffer_bytes
+      << "B</ReceiveBufferSize></Sizing>";
+  }
 
   if (d.shared_memory.enabled) {
     x << "<SharedMemory><Enable>true</Enable><LogLevel>warn</LogLevel></SharedMemory>";

@@ -29,8 +29,9 @@ const std::vector<std::string> top_keys = {"graph",     "args",          "domain
 const std::vector<std::string> host_keys = {"name", "address", "interface", "containers"};
 const std::vector<std::string> discovery_keys = {"multicast", "lease_duration_s",
                                                  "max_participants_per_host"};
-const std::vector<std::string> transport_keys = {"image_bytes", "image_rate_hz", "buffer_ms",
-                                                 "max_message_size", "fragment_size"};
+const std::vector<std::string> transport_keys = {"image_bytes",   "image_rate_hz",
+                                                 "buffer_ms",     "max_message_size",
+                                                 "fragment_size", "receive_buffer_bytes"};
 const std::vector<std::string> security_keys = {"enabled", "dir"};
 
 bool is_host_name(const std::string& s) {
@@ -189,6 +190,16 @@ void read_transport(Reading& st, const YAML::Node& node) {
       if (auto v = r.integer(e.value, what, 1024, 65500)) t.max_message_size = *v;
     } else if (e.key == "fragment_size") {
       if (auto v = r.integer(e.value, what, 0, 65500)) t.fragment_size = *v;
+    } else if (e.key == "receive_buffer_bytes") {
+      if (auto v = r.integer(e.value, what, 0, std::int64_t{1} << 30)) {
+        if (*v != 0 && static_cast<std::uint64_t>(*v) < Transport::kMinReceiveBufferBytes) {
+          r.error(e.value, what + ": " + std::to_string(*v) + " is below " +
+                               std::to_string(Transport::kMinReceiveBufferBytes) +
+                               " (or 0: Cyclone's default)");
+        } else {
+          t.receive_buffer_bytes = *v;
+        }
+      }
     }
   }
   if (t.fragment_size > t.max_message_size) {

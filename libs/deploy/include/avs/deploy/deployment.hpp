@@ -35,6 +35,14 @@ struct Transport {
   double buffer_ms = 32.0;                 ///< writer cache / socket buffers hold this much
   std::uint64_t max_message_size = 65500;  ///< UDP payload per RTPS message
   std::uint64_t fragment_size = 0;         ///< 0: Cyclone's default (1344 B, fits a 1500 MTU)
+  /// Cyclone's receive-buffer block (Sizing/ReceiveBufferSize): each receive thread carves the
+  /// messages it keeps out of one such block until it is full, then takes a new one. 0: its
+  /// default, 1 MiB; otherwise at least kMinReceiveBufferBytes.
+  std::uint64_t receive_buffer_bytes = 0;
+  /// Cyclone silently raises a block smaller than its largest message chunk
+  /// (ReceiveBufferChunkSize, 128 KiB) to that size, and a block of one chunk holds a single
+  /// kept message: smaller values are refused rather than changed behind the user's back.
+  static constexpr std::uint64_t kMinReceiveBufferBytes = 256 * 1024;
   /// Bytes one `buffer_ms` window of images needs: writer history (WhcHigh) and the
   /// receiver's socket buffer are sized to it.
   std::uint64_t window_bytes() const;
