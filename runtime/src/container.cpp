@@ -23,11 +23,45 @@ namespace avs::runtime {
 
 namespace {
 
+/// Samples posted to one subscription's lane and those skipped there (overload, see
+/// LocalSubscription::keep_last). Shared by the posted callbacks and the component's host.
+struct SubscriptionBacklog {
+  std::string port;                       ///< the component's port (for /diagnostics)
+  std::atomic<std::uint64_t> posted{0};   ///< samples posted to the lane so far
+  std::atomic<std::uint64_t> skipped{0};  ///< of those, dropped for newer ones
+};
+
 /// One sample callback of one component, already guarded (active check, exceptions).
 struct LocalSubscription {
   int lane;
   std::function<void(std::shared_ptr<const void>)> deliver;
+  /// KEEP_LAST depth on the lane (issue 16 section 3, skip to the newest input): a sample whose
+  /// turn comes when `keep_last` newer ones have been posted behind it is skipped and counted,
+  /// as a DDS reader's history of that depth would have overwritten it. 0: every sample is
+  /// delivered (lockstep and follower clocks, where time waits for the slowest component, and
+  /// open ports such as recorders, which account for every sample themselves).
+  std::uint32_t keep_last = 0;
+  std::shared_ptr<SubscriptionBacklog> backlog;
 };
+
+/// Queues `sample` for `sub` on its lane (the one path of local and DDS-received samples).
+void post_sample(Scheduler& scheduler, const LocalSubscription& sub,
+                 std::shared_ptr<const void> sample) {
+  if (sub.keep_last == 0) {
+    scheduler.post(sub.lane,
+                   [deliver = sub.deliver, sample = std::move(sample)] { deliver(sample); });
+    return;
+  }
+  const std::uint64_t seq = sub.backlog->posted.fetch_add(1, std::memory_order_relaxed) + 1;
+  scheduler.post(sub.lane, [deliver = sub.deliver, backlog = sub.backlog, keep = sub.keep_last, seq,
+                            sample = std::move(sample)] {
+    if (backlog->posted.load(std::memory_order_relaxed) - seq >= keep) {
+      backlog->skipped.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    deliver(sample);
+  });
+}
 
 /// Everything the container knows about one DDS topic.
 struct TopicEntry {
@@ -213,6 +247,9 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
   }
   /// The last check_timer_rates result (diagnostics timer only).
   std::optional<TimerShortfall> last_timer_check;
+  /// The last skipped_inputs result and rise (diagnostics timer only).
+  std::vector<std::pair<std::string, std::string>> last_skips;
+  std::uint64_t last_skip_rise = 0;
 
   void set_active(bool active) { active_ = active; }
   const graph::ComponentInstance& instance() const { return instance_; }
@@ -243,9 +280,12 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
   /// publisher/subscription: the writer (reader) and local delivery of one topic.
   TopicEntry& add_publication(const std::string& dds_name, const msg::TypeEntry& type,
                               const QosProfile& qos);
+  /// `skip_port`: the declared port whose lane keeps only the newest qos.depth samples under
+  /// overload (LocalSubscription::keep_last); empty: every sample is delivered.
   TopicEntry& add_subscription(const std::string& dds_name, const msg::TypeEntry& type,
                                const QosProfile& qos,
-                               std::function<void(std::shared_ptr<const void>)> callback);
+                               std::function<void(std::shared_ptr<const void>)> callback,
+                               std::string_view skip_port = {});
   /// An open-ports topic: (DDS name after namespace and remaps, its type entry).
   std::pair<std::string, const msg::TypeEntry*> resolve_open(const std::string& ros_topic,
                                                              const std::string& dds_type,
@@ -279,6 +319,34 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
   }
   /// The component's `rejected_samples` at the previous diagnostics report (diagnostics timer).
   std::uint64_t reported_rejections = 0;
+
+  /// Inputs skipped for newer ones (LocalSubscription::keep_last): `skipped_inputs` in all and
+  /// `skipped_inputs/<port>` per port that has skipped, for /diagnostics; the total rise since
+  /// the previous call in `*rise`. Logged (rate-limited: the first report with a rise, then
+  /// every 10th) so an overloaded stage says so. Diagnostics timer only.
+  std::vector<std::pair<std::string, std::string>> skipped_inputs(std::uint64_t* rise) {
+    std::vector<std::pair<std::string, std::string>> out;
+    std::uint64_t total = 0;
+    std::string ports;
+    for (const auto& b : backlogs_) {
+      const std::uint64_t n = b->skipped.load(std::memory_order_relaxed);
+      total += n;
+      if (n == 0) continue;
+      out.emplace_back("skipped_inputs/" + b->port, std::to_string(n));
+      ports += (ports.empty() ? "" : ", ") + b->port + " " + std::to_string(n);
+    }
+    if (backlogs_.empty()) return out;
+    out.insert(out.begin(), {"skipped_inputs", std::to_string(total)});
+    *rise = total - reported_skips_;
+    reported_skips_ = total;
+    if (*rise > 0 && skip_reports_++ % 10 == 0) {
+      log_.warn("input faster than this component: skipped ", *rise,
+                " sample(s) for newer ones since the last report (in all: ", ports,
+                "; each port keeps its QoS depth of the newest; warned every 10th report while it "
+                "lasts)");
+    }
+    return out;
+  }
 
  private:
   void record_callback(std::chrono::steady_clock::duration d) {
@@ -334,6 +402,9 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
   std::uint64_t shortfalls_ = 0;
   std::mutex stats_mutex_;
   Stats stats_;
+  std::vector<std::shared_ptr<const SubscriptionBacklog>> backlogs_;  ///< fixed once running
+  std::uint64_t reported_skips_ = 0;
+  std::uint64_t skip_reports_ = 0;
 };
 
 namespace {
@@ -343,9 +414,7 @@ class LocalPublisher final : public PublisherCore {
   LocalPublisher(Scheduler& scheduler, TopicEntry& topic) : scheduler_(scheduler), topic_(topic) {}
 
   void publish(std::shared_ptr<const void> sample) override {
-    for (const auto& sub : topic_.subscriptions) {
-      scheduler_.post(sub.lane, [deliver = sub.deliver, sample] { deliver(sample); });
-    }
+    for (const auto& sub : topic_.subscriptions) post_sample(scheduler_, sub, sample);
     // Serialise only when a reader in another participant wants it, now or (latched) later.
     topic_.tally.publish(*topic_.writer, sample.get(),
                          topic_.latched || topic_.writer->matched_readers() > 0);
@@ -378,16 +447,28 @@ TopicEntry& ComponentHost::add_publication(const std::string& dds_name, const ms
 
 TopicEntry& ComponentHost::add_subscription(
     const std::string& dds_name, const msg::TypeEntry& type, const QosProfile& qos,
-    std::function<void(std::shared_ptr<const void>)> callback) {
+    std::function<void(std::shared_ptr<const void>)> callback, std::string_view skip_port) {
   if (container_.running) throw Error("subscriptions must be created in the constructor");
   TopicEntry& topic = container_.topic(dds_name, type, qos);
   if (!topic.reader)
     topic.reader = std::make_unique<dds::Reader>(container_.participant, *topic.topic, qos);
   subscribed.push_back(&topic);
-  topic.subscriptions.push_back(
-      {lane_, [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
-         guard([&] { cb(std::move(sample)); })();
-       }});
+  LocalSubscription sub{lane_,
+                        [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
+                          guard([&] { cb(std::move(sample)); })();
+                        }};
+  // Only where the clock does not wait for the component (wall time, or simulated time paced
+  // at a real-time factor) can its input outrun it; in lockstep skipping would also make the
+  // result depend on thread timing.
+  const TimeMode mode = container_.scheduler->mode();
+  if (!skip_port.empty() && qos.depth > 0 &&
+      (mode == TimeMode::wall || mode == TimeMode::sim_realtime)) {
+    sub.keep_last = qos.depth;
+    sub.backlog = std::make_shared<SubscriptionBacklog>();
+    sub.backlog->port = std::string(skip_port);
+    backlogs_.push_back(sub.backlog);
+  }
+  topic.subscriptions.push_back(std::move(sub));
   return topic;
 }
 
@@ -401,7 +482,7 @@ std::shared_ptr<PublisherCore> ComponentHost::make_publisher(std::string_view po
 void ComponentHost::make_subscription(std::string_view port, const msg::TypeEntry& type,
                                       std::function<void(std::shared_ptr<const void>)> callback) {
   auto [dds_name, qos] = resolve(port, type, false);
-  add_subscription(dds_name, type, qos, std::move(callback));
+  add_subscription(dds_name, type, qos, std::move(callback), port);
 }
 
 std::pair<std::string, const msg::TypeEntry*> ComponentHost::resolve_open(
@@ -521,7 +602,10 @@ void Container::Impl::fail(const std::string& what) {
 void Container::Impl::publish_diagnostics(dds::Writer& writer) {
   const Time now = scheduler->now();
   // Timer rates are checked (and a shortfall warned) whether or not anyone reads /diagnostics.
-  for (auto& host : hosts) host->last_timer_check = host->check_timer_rates(now);
+  for (auto& host : hosts) {
+    host->last_timer_check = host->check_timer_rates(now);
+    host->last_skips = host->skipped_inputs(&host->last_skip_rise);
+  }
   if (writer.matched_readers() == 0) return;
   auto array = make_sample<msgs::diagnostic_msgs::DiagnosticArray>();
   const double interval_s = (now - last_diagnostics).count() * 1e-9;
@@ -566,6 +650,13 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
       } catch (const std::exception& e) {
         extra.emplace_back("diagnostic_values_error", e.what());
       }
+    }
+    for (auto& kv : host.last_skips) extra.push_back(kv);
+    if (host.last_skip_rise > 0 && !failed) {
+      status.level = 1;  // DiagnosticStatus WARN
+      set_string(status.message, "active, skipping to the newest input (" +
+                                     std::to_string(host.last_skip_rise) +
+                                     " since the last report)");
     }
     // Input rejected since the last report (SampleRejections' `rejected_samples`): WARN, so a
     // monitor sees bad inputs without reading the values.
@@ -618,9 +709,7 @@ void Container::Impl::reader_loop() {
           const auto* clock = static_cast<const rosgraph_msgs_msg_dds__Clock_*>(sample.get());
           scheduler->set_sim_time(from_ros_time(clock->clock));
         }
-        for (const auto& sub : topic.subscriptions) {
-          scheduler->post(sub.lane, [deliver = sub.deliver, sample] { deliver(sample); });
-        }
+        for (const auto& sub : topic.subscriptions) post_sample(*scheduler, sub, sample);
       }
     }
   }

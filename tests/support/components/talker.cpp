@@ -27,7 +27,10 @@ class TestTalker final : public runtime::Component {
                                           "reporting and respawn), 0 = never"),
                        ParamSpec::real("work_ms", 0.0, 0.0, 10000.0, "ms",
                                        "sleep this long in every tick (a stage slowed on "
-                                       "purpose: the timer cannot keep rate_hz)")},
+                                       "purpose: the timer cannot keep rate_hz)"),
+                       ParamSpec::integer("burst", 1, 1, 10000, "",
+                                          "messages published back to back in every tick (an "
+                                          "input faster than its subscribers)")},
         .publishes = {runtime::port<msgs::std_msgs::String>("chatter", "chatter"),
                       runtime::port<msgs::std_msgs::Float64>("count", "talker_count")},
         .subscribes = {}};
@@ -40,7 +43,8 @@ class TestTalker final : public runtime::Component {
         period_(static_cast<std::int64_t>(1e9 / ctx.param<double>("rate_hz"))),
         count_(ctx.param<std::int64_t>("count")),
         fail_after_(ctx.param<std::int64_t>("fail_after")),
-        work_(std::chrono::duration<double, std::milli>(ctx.param<double>("work_ms"))) {}
+        work_(std::chrono::duration<double, std::milli>(ctx.param<double>("work_ms"))),
+        burst_(ctx.param<std::int64_t>("burst")) {}
 
   void on_activate() override {
     timer_ = context().create_timer(period_, [this] { tick(); });
@@ -50,6 +54,10 @@ class TestTalker final : public runtime::Component {
  private:
   void tick() {
     if (work_.count() > 0) std::this_thread::sleep_for(work_);
+    for (std::int64_t i = 0; i < burst_; ++i) publish_one();
+  }
+
+  void publish_one() {
     if (count_ > 0 && seq_ >= static_cast<std::uint64_t>(count_)) return;
     if (fail_after_ > 0 && seq_ >= static_cast<std::uint64_t>(fail_after_)) {
       throw std::runtime_error("failing on purpose after " + std::to_string(seq_) + " messages");
@@ -72,6 +80,7 @@ class TestTalker final : public runtime::Component {
   std::int64_t count_;
   std::int64_t fail_after_;
   std::chrono::duration<double, std::milli> work_;
+  std::int64_t burst_;
   std::uint64_t seq_ = 0;
   runtime::TimerId timer_ = 0;
 };
