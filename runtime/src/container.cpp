@@ -11,6 +11,7 @@
 
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/raw_topic.hpp"
+#include "avs/runtime/realtime.hpp"
 #include "avs/runtime/ros_discovery.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "diagnostic_msgs.h"
@@ -869,6 +870,13 @@ int Container::run() {
     c.ros_discovery = std::make_unique<RosDiscoveryWriter>(c.participant);
     c.ros_discovery->publish(nodes);
   }
+
+  // Real-time settings (issue 16 section 3) for every thread there is now (the components'
+  // own included) and, inherited, the lanes and the DDS reader started below; undone when
+  // run() returns. A refused setting is a warning: the container runs without it.
+  const RealtimeScope realtime(spec_.realtime);
+  if (!realtime.applied().empty()) c.log.info("real-time settings: ", realtime.applied());
+  for (const std::string& line : realtime.refused()) c.log.warn(line);
 
   // Activate.
   c.running = true;

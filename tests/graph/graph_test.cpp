@@ -267,6 +267,19 @@ TEST_F(GraphTest, BadExecutor) {
   expect_one_error("bad_executor.yaml", 3, 15,
                    {"'executor'", "'single_threaded', 'thread_per_component'", "'multi_threaded'"});
 }
+TEST_F(GraphTest, RealtimeSettingsAreCheckedWhereWritten) {
+  expect_one_error("realtime_priority_without_fifo.yaml", 3, 37,
+                   {"'priority'", "needs sched fifo or rr"});
+  expect_one_error("realtime_fifo_without_priority.yaml", 3, 15,
+                   {"container 'box' 'realtime'", "need a 'priority' (1-99)"});
+  expect_one_error("realtime_cpu_twice.yaml", 3, 51, {"'cpus'", "CPU 1 listed twice"});
+  const LoadResult bad = load_graph(data("bad/realtime_bad_values.yaml"), {});
+  ASSERT_EQ(bad.errors.size(), 3u) << all_errors(bad);
+  EXPECT_NE(bad.errors[0].str().find("'other', 'fifo', 'rr', got 'deadline'"), std::string::npos)
+      << bad.errors[0].str();
+  EXPECT_NE(bad.errors[1].str().find("'priority'"), std::string::npos) << bad.errors[1].str();
+  EXPECT_NE(bad.errors[2].str().find("'lock_memory'"), std::string::npos) << bad.errors[2].str();
+}
 TEST_F(GraphTest, BadRespawnPolicy) {
   expect_one_error("bad_respawn.yaml", 3, 23,
                    {"'policy'", "'never', 'on_failure', 'always'", "'sometimes'"});
@@ -372,6 +385,12 @@ TEST_F(GraphTest, BasicGraphFillsDefaultsAndResolvesTopics) {
   EXPECT_DOUBLE_EQ(g.containers[0].respawn.backoff_s, 0.5);
   EXPECT_EQ(g.containers[1].host, "visionpc");
   EXPECT_EQ(g.containers[1].executor, ExecutorKind::single_threaded);
+  const RealtimeSpec& rt = g.containers[0].realtime;
+  EXPECT_EQ(rt.policy, RealtimeSpec::Policy::fifo);
+  EXPECT_EQ(rt.priority, 80);
+  EXPECT_EQ(rt.cpus, (std::vector<int>{0, 1}));
+  EXPECT_TRUE(rt.lock_memory);
+  EXPECT_FALSE(g.containers[1].realtime.any()) << "not given: nothing real-time";
   EXPECT_EQ(g.containers[1].respawn.kind, RespawnPolicy::Kind::always);
   EXPECT_EQ(g.args.at("rate_hz"), "100");
   EXPECT_EQ(g.args.at("speed"), "1.0");
@@ -387,7 +406,7 @@ TEST_F(GraphTest, BasicGraphFillsDefaultsAndResolvesTopics) {
   EXPECT_EQ(talker.parameters.all().size(), 6u);
   EXPECT_EQ(talker.remaps.at("chatter"), "/chat");
   EXPECT_EQ(talker.qos.at("chatter"), *runtime::QosProfile::named("sensor_data"));
-  EXPECT_EQ(talker.where.line, 14);
+  EXPECT_EQ(talker.where.line, 15);
 
   const auto& listener = component(g, "listener");
   const auto& qos = listener.qos.at("chatter");

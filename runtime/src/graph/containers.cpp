@@ -1,4 +1,6 @@
 // Reading containers (processes) and the graph-wide topic type check.
+#include <algorithm>
+
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "components.hpp"
@@ -7,8 +9,8 @@ namespace avs::graph {
 namespace detail {
 namespace {
 
-const std::vector<std::string> container_keys = {"name", "host", "executor", "respawn",
-                                                 "components"};
+const std::vector<std::string> container_keys = {"name",     "host",    "executor",
+                                                 "realtime", "respawn", "components"};
 const std::vector<std::string> respawn_kinds = {"never", "on_failure", "always"};
 
 std::optional<RespawnPolicy> read_respawn(const FileReader& reader, const YAML::Node& node,
@@ -39,6 +41,63 @@ std::optional<RespawnPolicy> read_respawn(const FileReader& reader, const YAML::
   }
   if (!ok) return std::nullopt;
   return policy;
+}
+
+/// `realtime: {sched: fifo, priority: 80, cpus: [2, 3], lock_memory: true}`.
+std::optional<RealtimeSpec> read_realtime(const FileReader& reader, const YAML::Node& node,
+                                          const std::string& what) {
+  RealtimeSpec rt;
+  bool ok = node.IsMap();
+  const auto entries =
+      map_entries(reader, node, what, {"sched", "priority", "cpus", "lock_memory"});
+  const Entry* priority_entry = nullptr;
+  for (const auto& e : entries) {
+    const std::string field = what + " '" + e.key + "'";
+    if (e.key == "sched") {
+      auto i = reader.choice(e.value, field, {"other", "fifo", "rr"});
+      if (i) rt.policy = static_cast<RealtimeSpec::Policy>(*i);
+      ok = ok && i.has_value();
+    } else if (e.key == "priority") {
+      priority_entry = &e;
+      auto n = reader.integer(e.value, field, 1, 99);
+      if (n) rt.priority = static_cast<int>(*n);
+      ok = ok && n.has_value();
+    } else if (e.key == "cpus") {
+      if (!e.value.IsSequence() || e.value.size() == 0) {
+        reader.error(e.value, field + ": expected a non-empty list of CPU numbers, got " +
+                                  node_kind(e.value));
+        ok = false;
+        continue;
+      }
+      for (const auto& item : e.value) {
+        auto cpu = reader.integer(item, field, 0, 1023);
+        if (!cpu) {
+          ok = false;
+        } else if (std::find(rt.cpus.begin(), rt.cpus.end(), *cpu) != rt.cpus.end()) {
+          reader.error(item, field + ": CPU " + std::to_string(*cpu) + " listed twice");
+          ok = false;
+        } else {
+          rt.cpus.push_back(static_cast<int>(*cpu));
+        }
+      }
+    } else if (e.key == "lock_memory") {
+      auto i = reader.choice(e.value, field, {"false", "true"});
+      if (i) rt.lock_memory = *i == 1;
+      ok = ok && i.has_value();
+    }
+  }
+  if (!ok) return std::nullopt;
+  const bool realtime_policy = rt.policy != RealtimeSpec::Policy::other;
+  if (realtime_policy && priority_entry == nullptr) {
+    reader.error(node, what + ": sched fifo and rr need a 'priority' (1-99)");
+    return std::nullopt;
+  }
+  if (!realtime_policy && priority_entry != nullptr) {
+    reader.error(priority_entry->value,
+                 what + " 'priority': needs sched fifo or rr (SCHED_OTHER has no priority)");
+    return std::nullopt;
+  }
+  return rt;
 }
 
 void read_container(LoadState& state, const FileReader& reader, const YAML::Node& node) {
@@ -78,6 +137,8 @@ void read_container(LoadState& state, const FileReader& reader, const YAML::Node
         container.executor =
             *i == 0 ? ExecutorKind::single_threaded : ExecutorKind::thread_per_component;
       }
+    } else if (e.key == "realtime") {
+      if (auto rt = read_realtime(reader, e.value, field)) container.realtime = *rt;
     } else if (e.key == "respawn") {
       if (auto policy = read_respawn(reader, e.value, field)) container.respawn = *policy;
     } else if (e.key == "components") {

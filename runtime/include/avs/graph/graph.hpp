@@ -50,10 +50,20 @@ struct RespawnPolicy {
   double backoff_s = 1.0;  ///< doubled after each restart
 };
 
+/// Real-time settings of a container's threads (issue 16 section 3, docs/realtime.md).
+struct RealtimeSpec {
+  enum class Policy { other, fifo, rr } policy = Policy::other;
+  int priority = 0;          ///< 1-99 with fifo and rr, 0 with other
+  std::vector<int> cpus;     ///< CPU affinity of every thread; empty: any CPU
+  bool lock_memory = false;  ///< mlockall: no page fault stalls a frame
+  bool any() const { return policy != Policy::other || !cpus.empty() || lock_memory; }
+};
+
 struct ContainerSpec {
   std::string name;
   std::string host;  ///< empty: any host
   ExecutorKind executor = ExecutorKind::single_threaded;
+  RealtimeSpec realtime;
   RespawnPolicy respawn;
   std::vector<ComponentInstance> components;
   SourceLocation where;
