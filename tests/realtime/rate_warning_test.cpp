@@ -149,7 +149,7 @@ TEST(SkipToNewest, ASlowSubscriberOnTheWallClockGetsTheNewestAndCountsTheRest) {
   ASSERT_TRUE(s.values.contains("skipped_inputs")) << log;
   EXPECT_EQ(s.values.at("skipped_inputs"), "40");
   EXPECT_EQ(s.values.at("skipped_inputs/chatter"), "40");
-  EXPECT_NE(log.find("skipped 40 sample(s) for newer ones"), std::string::npos) << log;
+  EXPECT_NE(log.find("sample(s) for newer ones"), std::string::npos) << log;
 }
 
 TEST(SkipToNewest, InLockstepEverySampleIsDelivered) {

@@ -104,18 +104,21 @@ function onDepth(m) {
   const little = !m.is_bigendian;
   const n = m.width * m.height;
   const depth = new Float32Array(n);
-  let lo = Infinity;
-  let hi = -Infinity;
+  const sample = [];  // every 7th valid depth, for the colour range
   for (let y = 0; y < m.height; y++) {
     for (let x = 0; x < m.width; x++) {
       const d = view.getFloat32(y * m.step + x * 4, little);
-      depth[y * m.width + x] = d;
-      if (Number.isFinite(d) && d > 0) {
-        if (d < lo) lo = d;
-        if (d > hi) hi = d;
-      }
+      const i = y * m.width + x;
+      depth[i] = d;
+      if (Number.isFinite(d) && d > 0 && i % 7 === 0) sample.push(d);
     }
   }
+  // The colour range spans the 1st to the 99th percentile of the valid depths, not min to max:
+  // a single stray pixel metres away (a wrong code at an edge) would otherwise paint the whole
+  // scene in the near colour. Depths outside the range take the end colours.
+  sample.sort((a, b) => a - b);
+  const lo = sample.length ? sample[Math.floor(0.01 * (sample.length - 1))] : 0;
+  const hi = sample.length ? sample[Math.ceil(0.99 * (sample.length - 1))] : 1;
   const canvas = $('depth');
   if (canvas.width !== m.width || canvas.height !== m.height) {
     canvas.width = m.width;
@@ -128,7 +131,7 @@ function onDepth(m) {
     const d = depth[i];
     let r = 0, g = 0, b = 0;
     if (Number.isFinite(d) && d > 0) {
-      [r, g, b] = hue((240 * (d - lo)) / span);
+      [r, g, b] = hue((240 * Math.min(Math.max(d - lo, 0), span)) / span);
     }
     image.data[4 * i] = r;
     image.data[4 * i + 1] = g;
