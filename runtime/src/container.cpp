@@ -340,6 +340,7 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
     out.insert(out.begin(), {"skipped_inputs", std::to_string(total)});
     *rise = total - reported_skips_;
     reported_skips_ = total;
+    if (*rise == 0) skip_reports_ = 0;  // the episode is over: the next one warns at once
     if (*rise > 0 && skip_reports_++ % 10 == 0) {
       log_.warn("input faster than this component: skipped ", *rise,
                 " sample(s) for newer ones since the last report (in all: ", ports,

@@ -1,15 +1,20 @@
 #include "avs/runtime/realtime.hpp"
 
 #include <sys/mman.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace avs::runtime {
 
 namespace {
+
+constexpr int CAP_IPC_LOCK_BIT = 14;  ///< linux/capability.h's CAP_IPC_LOCK
 
 const char* policy_name(graph::RealtimeSpec::Policy p) {
   switch (p) {
@@ -52,6 +57,22 @@ std::string cpu_list(const cpu_set_t& set) {
   return cpu_list(cpus);
 }
 
+/// CAP_IPC_LOCK (bit 14) in the effective set (/proc/self/status CapEff).
+bool has_ipc_lock() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("CapEff:", 0) == 0) {
+      return (std::stoull(line.substr(7), nullptr, 16) >> CAP_IPC_LOCK_BIT) & 1U;
+    }
+  }
+  return false;
+}
+
+bool thread_of_this_process(pid_t tid) {
+  std::error_code ec;
+  return std::filesystem::exists("/proc/self/task/" + std::to_string(tid), ec);
+}
+
 }  // namespace
 
 std::vector<pid_t> process_threads() {
@@ -63,7 +84,7 @@ std::vector<pid_t> process_threads() {
   return tids;
 }
 
-RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) {
+RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) : creator_(gettid()) {
   if (!spec.any()) return;
   for (pid_t tid : process_threads()) {
     Saved s{tid, sched_getscheduler(tid), {}, {}};
@@ -91,17 +112,18 @@ RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) {
                          " not available to this process (it may use " + cpu_list(allowed) +
                          "); running on all of them");
     } else {
-      int failures = 0;
+      int failures = 0, err = 0;
       for (Saved& s : saved_) {
         if (sched_setaffinity(s.tid, sizeof wanted, &wanted) == 0) {
           s.cpus_set = true;
-        } else {
+        } else if (errno != ESRCH) {  // ESRCH: the thread ended meanwhile
           ++failures;
+          err = errno;
         }
       }
       if (failures > 0) {
         refused_.push_back("realtime 'cpus' " + cpu_list(spec.cpus) + ": refused for " +
-                           std::to_string(failures) + " thread(s) (" + std::strerror(errno) + ")");
+                           std::to_string(failures) + " thread(s) (" + std::strerror(err) + ")");
       }
       done.push_back("CPUs " + cpu_list(spec.cpus));
     }
@@ -114,7 +136,7 @@ RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) {
     for (Saved& s : saved_) {
       if (sched_setscheduler(s.tid, policy_value(spec.policy), &param) == 0) {
         s.policy_set = true;
-      } else {
+      } else if (errno != ESRCH) {  // ESRCH: the thread ended meanwhile
         err = errno;
       }
     }
@@ -137,7 +159,16 @@ RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) {
   }
 
   if (spec.lock_memory) {
-    if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
+    rlimit limit{};
+    getrlimit(RLIMIT_MEMLOCK, &limit);
+    if (limit.rlim_cur != RLIM_INFINITY && !has_ipc_lock()) {
+      // mlockall(MCL_FUTURE) would succeed now and make every later allocation past the limit
+      // fail (a lane that cannot start, a bad_alloc mid-frame): refused before it can.
+      refused_.push_back("realtime 'lock_memory': the memlock limit is " +
+                         std::to_string(limit.rlim_cur / 1024) +
+                         " KiB (ulimit -l) and the process lacks CAP_IPC_LOCK: locking all future "
+                         "memory would make allocations past it fail; running unlocked");
+    } else if (mlockall(MCL_CURRENT | MCL_FUTURE) == 0) {
       locked_ = true;
       done.push_back("memory locked");
     } else {
@@ -152,6 +183,10 @@ RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) {
     }
   }
 
+  for (const Saved& s : saved_) {
+    any_policy_set_ = any_policy_set_ || s.policy_set;
+    any_cpus_set_ = any_cpus_set_ || s.cpus_set;
+  }
   if (!done.empty()) {
     for (const auto& d : done) {
       if (!applied_.empty()) applied_ += ", ";
@@ -163,9 +198,24 @@ RealtimeScope::RealtimeScope(const graph::RealtimeSpec& spec) {
 
 RealtimeScope::~RealtimeScope() {
   if (locked_) munlockall();
+  // A thread id of a thread that ended may belong to another process by now: only this
+  // process's threads are touched. Threads started while the scope held (a component's own,
+  // started on activation) inherited its settings and get those the creating thread had.
+  const Saved* caller = nullptr;
   for (const Saved& s : saved_) {
-    if (s.policy_set) sched_setscheduler(s.tid, s.policy, &s.param);
-    if (s.cpus_set) sched_setaffinity(s.tid, sizeof s.cpus, &s.cpus);
+    if (s.tid == creator_) caller = &s;
+  }
+  for (pid_t tid : process_threads()) {
+    const Saved* found = nullptr;
+    for (const Saved& s : saved_) {
+      if (s.tid == tid) found = &s;
+    }
+    const Saved* put_back = found != nullptr ? found : caller;
+    if (put_back == nullptr || !thread_of_this_process(tid)) continue;
+    const bool policy = found != nullptr ? found->policy_set : any_policy_set_;
+    const bool cpus = found != nullptr ? found->cpus_set : any_cpus_set_;
+    if (policy) sched_setscheduler(tid, put_back->policy, &put_back->param);
+    if (cpus) sched_setaffinity(tid, sizeof put_back->cpus, &put_back->cpus);
   }
 }
 

@@ -20,7 +20,8 @@ class RealtimeScope {
   /// Applies `spec` to every thread of this process; threads the calling thread starts later
   /// inherit the policy and the affinity (Linux's defaults for new threads).
   explicit RealtimeScope(const graph::RealtimeSpec& spec);
-  /// Puts back each thread's policy and affinity as they were (threads still alive), unlocks.
+  /// Puts back each thread's policy and affinity as they were (threads still alive; threads
+  /// started meanwhile get the creating thread's old ones), unlocks.
   ~RealtimeScope();
   RealtimeScope(const RealtimeScope&) = delete;
   RealtimeScope& operator=(const RealtimeScope&) = delete;
@@ -40,7 +41,10 @@ class RealtimeScope {
     bool policy_set = false;
     bool cpus_set = false;
   };
+  pid_t creator_;  ///< the thread that applied the settings (its old ones go to later threads)
   std::vector<Saved> saved_;
+  bool any_policy_set_ = false;
+  bool any_cpus_set_ = false;
   bool locked_ = false;
   std::string applied_;
   std::vector<std::string> refused_;
