@@ -37,6 +37,12 @@ class MatchingComponent final : public runtime::Component {
     keep_last_4.depth = 4;
     runtime::QosProfile keep_last_100;
     keep_last_100.depth = 100;
+    // The joint states are a history that each depth map's stamp is looked up in
+    // (JointHistory keeps 0.2 s): when a depth callback runs long on the wall clock, the
+    // port keeps 0.2 s of the head's 1 kHz states instead of skipping all but the newest 10,
+    // which left a hole around the stamps of the depth maps still queued.
+    runtime::QosProfile joint_history;
+    joint_history.depth = 200;
     runtime::QosProfile best_effort_2;
     best_effort_2.depth = 2;
     best_effort_2.reliability = runtime::Reliability::best_effort;
@@ -94,7 +100,8 @@ class MatchingComponent final : public runtime::Component {
                           "model_points", "/object/model_points", best_effort_2)},
         .subscribes =
             {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
-             runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states"),
+             runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states",
+                                                          joint_history),
              runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info", keep_last_4),
              runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info", "/depth/camera_info",
                                                           msg::camera_info_qos())},
