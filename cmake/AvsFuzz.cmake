@@ -46,7 +46,7 @@ if(AVS_FUZZ AND NOT AVS_FUZZ_BUILD AND AVS_BUILD_TESTS)
                  -DAVS_FUZZ_BUILD=ON -DAVS_BUILD_TESTS=OFF -DAVS_BUILD_BENCHMARKS=OFF
                  # clang's warnings differ from g++'s; the main build's -Werror guards the code.
                  -DAVS_WERROR=OFF
-                 -DAVS_ONLY_SUBDIRS=decode|geometry|servo|sim
+                 -DAVS_ONLY_SUBDIRS=camera|decode|geometry|projector|servo|sim
       LIST_SEPARATOR |
       BUILD_COMMAND ${build_command}
       INSTALL_COMMAND ""

@@ -2,7 +2,9 @@
 # The fuzzing campaign (issue 20 section 3): every libFuzzer target of tests/fuzz for SECONDS
 # each (default 600), one after another, then a table: target, executions, coverage (libFuzzer's
 # cov: edges and ft: features), findings (crash, hang over 1 s, out-of-memory or leak inputs).
-#   bash tools/fuzz.sh [SECONDS]        (AVS_BUILD_DIR: the CMake build, default build)
+#   bash tools/fuzz.sh [SECONDS [TARGETS]]   (TARGETS: a regular expression of CTest names, e.g.
+#                                             'sequencer|projector'; default all. AVS_BUILD_DIR:
+#                                             the CMake build, default build)
 # The targets, their seed corpora and the run limits are the CTest tests labelled `fuzz`
 # (cmake/AvsFuzz.cmake); this script runs the same commands longer, in fork mode so that a
 # finding is saved and the run goes on. Corpora grow in $BUILD/fuzz_campaign/<target>/corpus
@@ -11,15 +13,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-600}
+only=${2:-}
 build=${AVS_BUILD_DIR:-build}
-[[ "$seconds" =~ ^[1-9][0-9]*$ ]] || { echo "usage: bash tools/fuzz.sh [SECONDS > 0]" >&2; exit 2; }
+[[ "$seconds" =~ ^[1-9][0-9]*$ ]] || { echo "usage: bash tools/fuzz.sh [SECONDS > 0 [TARGETS]]" >&2; exit 2; }
 [ -f "$build/CMakeCache.txt" ] || { echo "fuzz.sh: no CMake build in $build (bash tools/run.sh test)" >&2; exit 2; }
 cmake --build "$build" -j "${AVS_JOBS:-$(nproc)}" --target avs_fuzz_build >/dev/null
 campaign=$(realpath "$build")/fuzz_campaign
 mkdir -p "$campaign"
 
 # One line per target: name, binary, its options (tab-separated), from CTest's own record.
-ctest --test-dir "$build" -L fuzz --show-only=json-v1 | python3 -c '
+ctest --test-dir "$build" -L fuzz ${only:+-R "$only"} --show-only=json-v1 | python3 -c '
 import json, sys
 for test in json.load(sys.stdin)["tests"]:
     command = test["command"]  # bash -c SCRIPT WORKDIR BINARY OPTIONS... new CORPUS...

@@ -6,6 +6,7 @@
 // (exactly as far while the lock holds), so the decoder never combines mislabelled bits.
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -281,6 +282,72 @@ TEST(PatternSequencer, SlipWithoutATraceIsCaughtByThePairStructure) {
   expect_true_labels(o);
   EXPECT_EQ(o.stats.verify_failures, 1);
   EXPECT_EQ(o.stats.locks, 2);
+}
+
+TEST(PatternSequencer, SlipRightAfterABridgedGapIsCaughtToo) {
+  // Found by fuzz_pattern_sequencer: frames lost in transport (the ids skip as many), then a
+  // slip without a trace. The first pair after the gap had no pair two frames back to be
+  // compared with and was labelled unchecked; it is now checked against the last pair before
+  // the gap.
+  std::vector<Delivery> s = stream(0, 12 * kFramesPerCycle);
+  erase_f(s, 4 * kFramesPerCycle + 2, 4 * kFramesPerCycle + 8);  // 6 frames, ids skip 6
+  for (Delivery& d : s) {
+    if (d.f >= 4 * kFramesPerCycle + 9) d.f += 1;  // the frame after the gap's first slipped
+  }
+  const Outcome o = run(s);
+  expect_true_labels(o);
+  EXPECT_EQ(o.stats.bridged_gaps, 1);
+  EXPECT_EQ(o.stats.verify_failures, 1);
+  EXPECT_EQ(o.stats.locks, 2);
+}
+
+TEST(PatternSequencer, RestartSoonAfterStartIsNotTakenForLateFrames) {
+  // Found by fuzz_pattern_sequencer: the camera restarts 100 frames after it started, its ids
+  // from 1 and its clock from the same origin again. The new ids looked like frames completed
+  // late (older ids, timestamps as much older) and were dropped until they passed the old
+  // ones; from there they continued the old ids, 100 frames off, and the lock stayed.
+  std::vector<Delivery> s = stream(0, 100);
+  for (const Delivery& d : stream(0, 10 * kFramesPerCycle)) s.push_back({d.f + 100, d.id, d.t_ns});
+  const Outcome o = run(s);
+  expect_true_labels(o);
+  EXPECT_EQ(o.stats.late_frames, 0);
+  EXPECT_GE(o.stats.restarts, 1);
+  EXPECT_GT(o.labelled, 0);
+}
+
+TEST(PatternSequencer, SlipAfterGapsLongerThanTheBridgeIsNotLabelled) {
+  // Found by fuzz_pattern_sequencer: gaps of 16 frames, each bridged, one after another for
+  // longer than the bridge (180 frames), so that no pair was checked meanwhile, then a slip:
+  // the first pair had nothing within reach to be compared with and was labelled. It is now
+  // not labelled; its sum is the reference for the next pair.
+  std::vector<Delivery> s = stream(0, 30 * kFramesPerCycle);
+  const std::int64_t from = 4 * kFramesPerCycle, to = from + 17 * 12;
+  std::erase_if(s, [&](const Delivery& d) { return d.f >= from && d.f < to && (d.f - from) % 17 != 0; });
+  for (Delivery& d : s) {
+    if (d.f >= to + 1) d.f += 1;  // the slip
+  }
+  const Outcome o = run(s);
+  expect_true_labels(o);
+  EXPECT_GE(o.stats.unverified_pairs, 1);
+  EXPECT_GE(o.stats.verify_failures, 1);
+}
+
+TEST(PatternSequencer, ClockJumpingAcrossTheRangeIsARestartNotAnOverflow) {
+  // Camera timestamps are outside input: a jump from near INT64_MIN to near INT64_MAX (the
+  // difference does not fit in 64 bits) was signed overflow (undefined behaviour, found by
+  // fuzz_pattern_sequencer under UBSan); it is a restart: lock lost, later frames true.
+  std::vector<Delivery> s = stream(0, 10 * kFramesPerCycle);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s[i].t_ns += i < 4 * kFramesPerCycle ? std::numeric_limits<std::int64_t>::min() / 2 * 2
+                                         : std::numeric_limits<std::int64_t>::max() / 2;
+  }
+  const Outcome o = run(s);
+  expect_true_labels(o);
+  EXPECT_EQ(o.stats.restarts, 1);
+  EXPECT_EQ(o.stats.lock_losses, 1);
+  EXPECT_GT(std::count_if(o.labelled_f.begin(), o.labelled_f.end(),
+                          [](std::int64_t f) { return f >= 4 * kFramesPerCycle; }),
+            0);  // labelling resumed after the jump
 }
 
 TEST(PatternSequencer, TimestampJitterWithinToleranceIsNoGap) {

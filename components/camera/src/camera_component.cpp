@@ -210,6 +210,7 @@ class CameraComponent final : public runtime::Component {
             {"locks", text(s.locks)},
             {"lock_losses", text(s.lock_losses)},
             {"pair_mismatches", text(s.verify_failures)},
+            {"pairs_unverified", text(s.unverified_pairs)},
             {"dropped_not_locked", text(s.dropped_not_locked)},
             {"dropped_unpaired", text(s.dropped_unpaired)},
             {"locked", s.locks > s.lock_losses ? "true" : "false"},

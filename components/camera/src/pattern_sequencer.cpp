@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -25,6 +26,8 @@ std::string_view to_string(DropReason reason) {
       return "pair partner lost";
     case DropReason::kVerifyFailed:
       return "pair structure mismatch";
+    case DropReason::kUnverified:
+      return "pair not checkable";
     case DropReason::kFlushed:
       return "flushed";
   }
@@ -45,6 +48,12 @@ PatternSequencer::PatternSequencer(SequencerConfig config)
                                 std::to_string(config_.frame_id_bits) + ", expected 2..64");
   }
   if (config_.lock_cycles < 1) throw std::invalid_argument("PatternSequencer: lock_cycles < 1");
+  if (config_.max_bridged_gap_frames < 0 || config_.max_bridged_gap_frames > 1'000'000) {
+    throw std::invalid_argument("PatternSequencer: max_bridged_gap_frames " +
+                                std::to_string(config_.max_bridged_gap_frames) +
+                                ", expected 0..1000000");
+  }
+  received_.assign(static_cast<std::size_t>(config_.max_bridged_gap_frames) + 1, -1);
   if (config_.relock_cycle_jump < 2) {
     throw std::invalid_argument("PatternSequencer: relock_cycle_jump < 2");
   }
@@ -71,6 +80,7 @@ Released PatternSequencer::push(const CameraFrame& frame) {
     last_id_ = frame.frame_id;
     last_timestamp_ns_ = frame.timestamp_ns;
     position_ = 0;
+    note_received();
     hunt(frame, false, out);
     return out;
   }
@@ -80,28 +90,49 @@ Released PatternSequencer::push(const CameraFrame& frame) {
     out.add(release(frame, DropReason::kDuplicate));
     return out;
   }
-  const std::int64_t dt_ns = frame.timestamp_ns - last_timestamp_ns_;
+  // A camera's clock is outside input: one that jumps across the int64 range is a restart,
+  // never an overflow.
+  std::int64_t dt_ns = 0;
+  const bool clock_jumped = __builtin_sub_overflow(frame.timestamp_ns, last_timestamp_ns_, &dt_ns);
   const double periods = static_cast<double>(dt_ns) * 1e-9 / config_.frame_period_s;
   const bool consistent =
+      !clock_jumped &&
       std::abs(periods - static_cast<double>(step)) <= config_.gap_tolerance_periods;
-  if (step < 0 && consistent && -step <= config_.max_bridged_gap_frames) {
+  // A frame completed after newer ones has an id that was missing. An id received before,
+  // with a timestamp that fits its old place, is a camera that restarted its ids and its clock
+  // soon after it started (found by fuzz_pattern_sequencer: taken as late frames, the new ids
+  // then continued the old ones, shifted by a restart's worth of exposures): a restart below.
+  if (step < 0 && consistent && -step <= config_.max_bridged_gap_frames &&
+      !was_received(position_ + step)) {
     ++stats_.late_frames;  // completed after newer frames: nothing to relabel
+    mark_received(position_ + step);
     out.add(release(frame, DropReason::kLate));
     return out;
   }
   last_id_ = frame.frame_id;
   last_timestamp_ns_ = frame.timestamp_ns;
-  if (step < 0 || dt_ns <= 0) {  // ids or clock went back: the camera restarted
+  if (step < 0 || dt_ns <= 0 || clock_jumped) {  // ids or clock went back: the camera restarted
     ++stats_.restarts;
     ++stats_.gaps;
-    position_ += 1;
+    // Not adjacent to anything before (no pair across a restart), and no earlier id's place
+    // is taken for one of the new ids.
+    position_ += config_.max_bridged_gap_frames + 2;
+    note_received();
     lose_lock(out);
     hunt(frame, false, out);
     return out;
   }
-  if (step > 1) stats_.missing_ids += step - 1;
+  if (step > 1) {  // saturating: ids of any width may jump by up to half their range
+    stats_.missing_ids = step - 1 > std::numeric_limits<std::int64_t>::max() - stats_.missing_ids
+                             ? std::numeric_limits<std::int64_t>::max()
+                             : stats_.missing_ids + (step - 1);
+  }
   if (step != 1 || !consistent) ++stats_.gaps;
-  position_ += consistent ? step : std::max<std::int64_t>(step, std::llround(periods)) + 1;
+  // Past a gap that cannot be bridged only "not adjacent" matters (no pair across it): a
+  // bounded advance keeps position_ from overflowing on ids or clocks that jump far.
+  const std::int64_t bridge = config_.max_bridged_gap_frames;
+  position_ += consistent && step <= bridge ? step : bridge + 2;
+  note_received();
   if (locked_) {
     if (consistent && step <= config_.max_bridged_gap_frames) {
       if (step > 1) ++stats_.bridged_gaps;
@@ -112,6 +143,15 @@ Released PatternSequencer::push(const CameraFrame& frame) {
   }
   hunt(frame, consistent && step == 1, out);
   return out;
+}
+
+bool PatternSequencer::was_received(std::int64_t position) const {
+  if (position < 0) return false;  // before the first frame seen
+  return received_[static_cast<std::size_t>(position) % received_.size()] == position;
+}
+
+void PatternSequencer::mark_received(std::int64_t position) {
+  if (position >= 0) received_[static_cast<std::size_t>(position) % received_.size()] = position;
 }
 
 Released PatternSequencer::flush() {
@@ -138,7 +178,7 @@ void PatternSequencer::hunt(const CameraFrame& frame, bool continuous, Released&
   if (!continuous) lose_lock(out);
   Structure s;
   if (held_ && held_position_ == position_ - 1) {
-    s.sum_difference = couple_sum_difference(frame, 2);
+    s.sum_difference = couple_sum_difference(frame, 2, 2);
     s.density = couple_density(frame);
   }
   run_.push_back(s);
@@ -163,7 +203,8 @@ void PatternSequencer::hunt(const CameraFrame& frame, bool continuous, Released&
   if (last_emitted_cycle_ >= 0) {
     const double cycle_s = config_.frame_period_s * static_cast<double>(frames_per_cycle_);
     const double elapsed_s = std::max(
-        static_cast<double>(frame.timestamp_ns - last_emitted_timestamp_ns_) * 1e-9,
+        (static_cast<double>(frame.timestamp_ns) -
+         static_cast<double>(last_emitted_timestamp_ns_)) * 1e-9,
         static_cast<double>(stats_.frames - last_emitted_frames_) * config_.frame_period_s);
     next_cycle =
         last_emitted_cycle_ +
@@ -211,7 +252,8 @@ bool PatternSequencer::structure_locks() const {
   return true;
 }
 
-double PatternSequencer::couple_sum_difference(const CameraFrame& frame, int distance) {
+double PatternSequencer::couple_sum_difference(const CameraFrame& frame, std::int64_t distance,
+                                               std::int64_t max_distance) {
   const decode::ImageView8& a = held_->image;
   const decode::ImageView8& b = frame.image;
   if (a.width != b.width || a.height != b.height || a.data == nullptr || b.data == nullptr) {
@@ -230,7 +272,9 @@ double PatternSequencer::couple_sum_difference(const CameraFrame& frame, int dis
   }
   const std::size_t slot = static_cast<std::size_t>(position_ & 1);
   double result = -1;
-  if (sum_position_[slot] == position_ - distance && sums_[slot].size() == pixels) {
+  const std::int64_t back = position_ - sum_position_[slot];
+  if (sum_position_[slot] >= 0 && back >= distance && back <= max_distance &&
+      sums_[slot].size() == pixels) {
     const std::uint16_t* old = sums_[slot].data();
     const std::uint16_t* now = scratch_.data();
     const int lit_min = config_.lit_sum_min;
@@ -313,7 +357,24 @@ void PatternSequencer::locked_push(const CameraFrame& frame, Released& out) {
     out.add(release(frame, DropReason::kUnpaired));
     return;
   }
-  const double difference = config_.verify_pairs ? couple_sum_difference(frame, 2) : -1;
+  // Against the previous pair, or after a bridged gap the last pair before it (same parity
+  // slot): a pair after a gap released unverified let a camera that also slipped an exposure
+  // there be mislabelled (found by fuzz_pattern_sequencer). Across a long gap a moving scene
+  // may fail the check: that drops the lock (frames lost), never a label.
+  const double difference =
+      config_.verify_pairs
+          ? couple_sum_difference(frame, 2, 2 + static_cast<std::int64_t>(config_.max_bridged_gap_frames))
+          : -1;
+  if (config_.verify_pairs && difference < 0) {
+    // Nothing to check it against (every pair since the last checked one lost in gaps for
+    // longer than the bridge, found by fuzz_pattern_sequencer with a slip after them; or too
+    // few lit pixels): not labelled, its sum is the reference for the next pair.
+    ++stats_.unverified_pairs;
+    out.add(release(*held_, DropReason::kUnverified));
+    held_.reset();
+    out.add(release(frame, DropReason::kUnverified));
+    return;
+  }
   if (difference > config_.pair_sum_match_max) {
     ++stats_.verify_failures;
     out.add(release(*held_, DropReason::kVerifyFailed));
@@ -345,7 +406,8 @@ ReleasedFrame PatternSequencer::release(const CameraFrame& f, DropReason reason,
     case DropReason::kDuplicate:
     case DropReason::kLate:
     case DropReason::kVerifyFailed:
-      break;  // counted where they are detected
+    case DropReason::kUnverified:
+      break;  // counted (per pair) where they are detected
   }
   return {f.token, f.frame_id, reason, label};
 }

@@ -16,10 +16,14 @@
 //     id, ids going back or restarting, steps longer than max_bridged_gap_frames) drops the
 //     lock. A duplicated id is dropped, and so is a late one (an id at most
 //     max_bridged_gap_frames older than the last with a timestamp as much older: a frame the
-//     transport completed after newer ones). A positive is held until its negative: the pair is
-//     released only when its sum matches the previous pair's (the structure above), so a
+//     transport completed after newer ones; an older id received before is a restart). A
+//     positive is held until its negative: the pair is
+//     released only when its sum matches the previous pair's (the structure above; a pair
+//     with nothing to compare with is not labelled, its sum becomes the reference), so a
 //     camera that slipped one exposure without a trace in its ids is caught before a frame
-//     of it is labelled.
+//     of it is labelled (also across a bridged gap: the first pair after it is checked against
+//     the last pair before it). Sums cannot see a shift by a whole pair (two slips with no
+//     checked pair between them): a true pair of another bit has the same sum.
 //
 // Core, no I/O: the caller owns the images and keeps a frame's image valid until the
 // sequencer releases the frame (at most one frame is held between calls).
@@ -85,6 +89,7 @@ enum class DropReason : std::uint8_t {
   kLate,          ///< an older id than the last, its timestamp as much older (completed late)
   kUnpaired,      ///< its pair partner was lost (a lone frame cannot be verified or decoded)
   kVerifyFailed,  ///< the pair's structure did not match: lock dropped
+  kUnverified,    ///< no earlier pair to check the pair against (long gaps, dark): not labelled
   kFlushed,       ///< still held at flush()
 };
 
@@ -113,6 +118,7 @@ struct SequencerStats {
   std::int64_t late_frames = 0;  ///< older ids arriving after newer ones; dropped
   std::int64_t dropped_unpaired = 0;
   std::int64_t verify_failures = 0;  ///< pairs whose structure did not match (lock dropped)
+  std::int64_t unverified_pairs = 0;  ///< pairs with nothing to check them against: dropped
   std::int64_t missing_ids = 0;      ///< ids skipped by forward gaps
   std::int64_t gaps = 0;          ///< discontinuities of any kind (id skips, time steps, restarts)
   std::int64_t bridged_gaps = 0;  ///< gaps crossed while staying locked
@@ -142,13 +148,19 @@ class PatternSequencer {
   };
 
   std::int64_t id_step(std::uint64_t id) const;
+  /// Whether a frame was received at `position` (within the last max_bridged_gap_frames).
+  bool was_received(std::int64_t position) const;
+  void mark_received(std::int64_t position);
+  void note_received() { mark_received(position_); }
   void lose_lock(Released& out);
   void hunt(const CameraFrame& frame, bool continuous, Released& out);
   void locked_push(const CameraFrame& frame, Released& out);
   bool structure_locks() const;
   /// Mean |S - S_stored| / mean S over lit pixels of the couple (held, frame), storing S;
-  /// -1 when too few pixels are lit or no stored sum is `distance` frames back.
-  double couple_sum_difference(const CameraFrame& frame, int distance);
+  /// -1 when too few pixels are lit or the stored sum of this parity is not `distance` to
+  /// `max_distance` frames back.
+  double couple_sum_difference(const CameraFrame& frame, std::int64_t distance,
+                               std::int64_t max_distance);
   double couple_density(const CameraFrame& frame) const;
   ReleasedFrame release(const CameraFrame& f, DropReason reason, FrameLabel label = {});
   FrameLabel label_of(std::int64_t sequence) const;
@@ -161,6 +173,9 @@ class PatternSequencer {
   std::uint64_t last_id_ = 0;
   std::int64_t last_timestamp_ns_ = 0;
   std::int64_t position_ = 0;  ///< unwrapped frame count of the last frame
+  /// The positions received, by position modulo max_bridged_gap_frames + 1 (-1: none): a frame
+  /// with an older id is late only if nothing was received at its place.
+  std::vector<std::int64_t> received_;
 
   std::optional<CameraFrame> held_;
   std::int64_t held_position_ = 0;
