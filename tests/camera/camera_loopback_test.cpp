@@ -5,9 +5,13 @@
 // the sim camera's clock k / rate), its label frame k's true pattern; it feeds the same frames
 // with the same labels to a RollingDecoder of its own (the direct simulator path), and every
 // /depth/image decode publishes must equal that decoder's map bit for bit. With frames dropped
-// on purpose, every gap is counted and depth resumes after it.
+// on purpose, every gap is counted and depth resumes after it. With the ken in the scene, two
+// `matching` instances take the maps of both paths: the poses must agree within 1e-6.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -22,6 +26,7 @@
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/sim/scene.hpp"
+#include "avs/sim/scene_yaml.hpp"
 #include "avs/sim/simulator.hpp"
 #include "avs/testing/lockstep_graph.hpp"
 #include "sim_gige_camera.hpp"
@@ -45,18 +50,30 @@ class TestCameraChecker final : public runtime::Component {
     keep_last_100.depth = 100;
     return {.type = "test_camera_checker",
             .description = "tests: /camera/pattern vs the simulator, /depth/image vs direct decode",
-            .parameters = {},
-            .publishes = {},
+            .parameters = {ParamSpec::string("scene", "", "scene YAML (empty: a plane at 1.04 m)"),
+                           ParamSpec::boolean("forward_maps", false,
+                                              "forward both paths' maps to two matchings")},
+            .publishes = {runtime::port<msgs::sensor_msgs::Image>(
+                              "checked_depth", "/checked/depth/image", keep_last_100),
+                          runtime::port<msgs::sensor_msgs::Image>(
+                              "direct_depth", "/direct/depth/image", keep_last_100)},
             .subscribes = {
                 runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern",
                                                             keep_last_100),
-                runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_100)}};
+                runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_100),
+                runtime::port<msgs::geometry_msgs::PoseStamped>(
+                    "checked_pose", "/checked/object/pose", keep_last_100),
+                runtime::port<msgs::geometry_msgs::PoseStamped>(
+                    "direct_pose", "/direct/object/pose", keep_last_100)}};
   }
 
   explicit TestCameraChecker(ComponentContext& ctx)
       : Component(ctx),
-        sim_(sim_config(), sim::Scene{{sim::make_background_plane(1.04)}}),
-        decoder_(decode::DecoderConfig{}) {
+        sim_(make_simulator(ctx.param<std::string>("scene"))),
+        decoder_(decode::DecoderConfig{}),
+        forward_maps_(ctx.param<bool>("forward_maps")),
+        checked_depth_(ctx.publisher<msgs::sensor_msgs::Image>("checked_depth")),
+        direct_depth_(ctx.publisher<msgs::sensor_msgs::Image>("direct_depth")) {
     // The frames sim_camera repeats (prerender_cycles), rendered the same way.
     for (std::uint64_t k = 0; k < kPrerenderCycles * 2 * kBits; ++k) {
       frames_.push_back(
@@ -66,7 +83,19 @@ class TestCameraChecker final : public runtime::Component {
         "pattern", [this](runtime::SamplePtr<msgs::avs_msgs::PatternFrame> m) { on_pattern(*m); });
     ctx.subscribe<msgs::sensor_msgs::Image>(
         "depth", [this](runtime::SamplePtr<msgs::sensor_msgs::Image> m) { on_depth(*m); });
+    ctx.subscribe<msgs::geometry_msgs::PoseStamped>(
+        "checked_pose", [this](runtime::SamplePtr<msgs::geometry_msgs::PoseStamped> m) {
+          checked_poses[frame_number(m->header.stamp)] = pose_of(*m);
+        });
+    ctx.subscribe<msgs::geometry_msgs::PoseStamped>(
+        "direct_pose", [this](runtime::SamplePtr<msgs::geometry_msgs::PoseStamped> m) {
+          direct_poses[frame_number(m->header.stamp)] = pose_of(*m);
+        });
   }
+
+  /// Position (m) and orientation (x, y, z, w) of each pose, by frame number of its map.
+  std::map<std::int64_t, std::array<double, 7>> checked_poses, direct_poses;
+  std::int64_t forwarded_maps = 0;
 
   std::int64_t patterns = 0, wrong_bytes = 0, wrong_labels = 0;
   std::int64_t depth_maps = 0, equal_maps = 0, unmatched_maps = 0, valid_pixels = 0;
@@ -74,10 +103,39 @@ class TestCameraChecker final : public runtime::Component {
   std::vector<std::int64_t> depth_k;    ///< of the newest frame of every depth map
 
  private:
-  static sim::SimulatorConfig sim_config() {
+  /// The simulator sim_camera serves (its make_simulator: the scene file's, at our rate).
+  static sim::Simulator make_simulator(const std::string& scene) {
     sim::SimulatorConfig c;
+    sim::Scene objects{{sim::make_background_plane(1.04)}};
+    if (!scene.empty()) {
+      sim::SceneFile file = sim::load_scene(scene);
+      c = file.config;
+      objects = std::move(file.scene);
+    }
     c.frame_rate_hz = kRateHz;
-    return c;
+    return sim::Simulator(c, std::move(objects));
+  }
+
+  static std::array<double, 7> pose_of(const msgs::geometry_msgs::PoseStamped& m) {
+    const auto& p = m.pose.position;
+    const auto& q = m.pose.orientation;
+    return {p.x, p.y, p.z, q.x, q.y, q.z, q.w};
+  }
+
+  /// A 32FC1 map as decode publishes it.
+  static std::shared_ptr<msgs::sensor_msgs::Image> depth_image(
+      const msgs::sensor_msgs::Image& like, const float* z, std::size_t count) {
+    auto image = runtime::make_sample<msgs::sensor_msgs::Image>();
+    image->header.stamp = like.header.stamp;
+    runtime::set_string(image->header.frame_id,
+                        like.header.frame_id != nullptr ? like.header.frame_id : "");
+    runtime::set_string(image->encoding, "32FC1");
+    image->width = like.width;
+    image->height = like.height;
+    image->step = like.step;
+    runtime::resize_sequence(image->data, static_cast<std::uint32_t>(4 * count));
+    std::memcpy(image->data._buffer, z, 4 * count);
+    return image;
   }
 
   static std::int64_t frame_number(const msgs::builtin_interfaces::Time& stamp) {
@@ -127,10 +185,20 @@ class TestCameraChecker final : public runtime::Component {
       valid_pixels += std::isfinite(z[i]) ? 1 : 0;
     }
     equal_maps += equal ? 1 : 0;
+    // Both paths' maps to the two matchings, from the third map on (decode's /depth/camera_info
+    // has long reached both by then), so that each starts from the same map and sees the
+    // same ones: the capture path's (the bytes decode published) and the direct path's.
+    if (forward_maps_ && depth_maps > 2) {
+      ++forwarded_maps;
+      checked_depth_.publish(depth_image(m, z, direct.size()));
+      direct_depth_.publish(depth_image(m, direct.data(), direct.size()));
+    }
   }
 
   sim::Simulator sim_;
   decode::RollingDecoder decoder_;
+  bool forward_maps_;
+  runtime::Publisher<msgs::sensor_msgs::Image> checked_depth_, direct_depth_;
   std::vector<std::vector<std::uint8_t>> frames_;
   std::map<std::int64_t, std::vector<float>> direct_;  ///< by frame number of the negative
 };
@@ -152,22 +220,34 @@ std::int64_t count(const std::map<std::string, std::string>& d, const std::strin
 }
 
 /// sim_camera + camera + decode + checker on the wall clock for `seconds`.
-testing::ContainerRun run_loopback(const std::string& sim_camera_extra, double seconds) {
+testing::ContainerRun run_loopback(const std::string& sim_camera_extra, double seconds,
+                                   const std::string& checker_parameters = "{}",
+                                   const std::vector<std::string>& more = {}) {
   const std::string rate = std::to_string(kRateHz);
-  return testing::run_wall_clock_container(
+  std::vector<std::string> components =
       // The checker and decode first: active before the camera's first frame. Decode keeps the
       // newest 100 frames instead of its 4 (docs/runtime.md, skip to the newest): this test
       // compares every map bit for bit, so on a loaded machine decode must catch up rather
       // than skip frames the checker's own decoder got.
-      {"{type: test_camera_checker, name: checker}",
+      {"{type: test_camera_checker, name: checker, parameters: " + checker_parameters + "}",
        "{type: decode, name: decode, qos: {pattern: {depth: 100}}}",
        "{type: sim_camera, name: sim_camera, parameters: {frame_rate_hz: " + rate +
            ", prerender_cycles: " + std::to_string(kPrerenderCycles) + ", first_frame_id: 65200" +
            sim_camera_extra + "}}",
        "{type: camera, name: camera, parameters: {device_id: 127.0.0.1, trigger_mode: free_run, "
        "frame_rate_hz: " +
-           rate + ", stamp_source: camera, socket_buffer_bytes: 8000000, image_raw_rate_hz: 10}}"},
-      seconds);
+           rate + ", stamp_source: camera, socket_buffer_bytes: 8000000, image_raw_rate_hz: 10}}"};
+  components.insert(components.end(), more.begin(), more.end());
+  return testing::run_wall_clock_container(components, seconds);
+}
+
+/// A `matching` on the maps of one path (`checked` or `direct`), with its own topics; it keeps
+/// every map (no skipping to the newest), so both see the same ones.
+std::string matching_on(const std::string& path) {
+  return "{type: matching, name: matching_" + path + ", remap: {depth: /" + path +
+         "/depth/image, pose: /" + path + "/object/pose, pose_world: /" + path +
+         "/object/pose_world, match: /" + path + "/object/match, timing: /" + path +
+         "/timing}, qos: {depth: {depth: 1000}}}";
 }
 
 TEST(CameraLoopback, DepthOverGigEVisionEqualsTheDirectSimulatorPath) {
@@ -188,6 +268,56 @@ TEST(CameraLoopback, DepthOverGigEVisionEqualsTheDirectSimulatorPath) {
   // Frame ids went 65200 .. 65535, 1, ...: the wrap is no restart.
   EXPECT_GT(count(camera, "frames_received"), 340);
   EXPECT_EQ(count(camera, "restarts"), 0);
+}
+
+TEST(CameraLoopback, PosesOverGigEVisionEqualTheDirectSimulatorPath) {
+  // The ken 1 m ahead (static_ken.yaml): matching on the maps that came over GigE Vision and
+  // matching on the direct simulator path's maps give the same poses (issue 15: within 1e-6).
+  const std::string scene =
+      std::string(std::getenv("AVS_SOURCE_DIR")) + "/launch_config/scenes/static_ken.yaml";
+  const testing::ContainerRun run = run_loopback(
+      ", scene: " + scene, 6.0, "{scene: " + scene + ", forward_maps: true}",
+      {matching_on("checked"), matching_on("direct")});
+  ASSERT_TRUE(run.load_errors.empty()) << run.load_errors.front();
+  ASSERT_EQ(run.status, 0);
+  const auto* checker = run.find<TestCameraChecker>("checker");
+  ASSERT_NE(checker, nullptr);
+  EXPECT_EQ(checker->wrong_bytes, 0);
+  EXPECT_EQ(checker->wrong_labels, 0);
+  EXPECT_EQ(checker->unmatched_maps, 0);
+  EXPECT_EQ(checker->equal_maps, checker->depth_maps);
+  EXPECT_GT(checker->forwarded_maps, 50);
+  // Poses of the same maps (the run may stop between the two matchings' turns at the end).
+  std::int64_t common = 0;
+  double position_m = 0, orientation = 0;
+  for (const auto& [k, a] : checker->checked_poses) {
+    const auto it = checker->direct_poses.find(k);
+    if (it == checker->direct_poses.end()) continue;
+    ++common;
+    const auto& b = it->second;
+    position_m = std::max({position_m, std::abs(a[0] - b[0]), std::abs(a[1] - b[1]),
+                           std::abs(a[2] - b[2])});
+    // Quaternion components (q and -q are the same rotation).
+    double same = 0, opposite = 0;
+    for (int i = 3; i < 7; ++i) {
+      same = std::max(same, std::abs(a[i] - b[i]));
+      opposite = std::max(opposite, std::abs(a[i] + b[i]));
+    }
+    orientation = std::max(orientation, std::min(same, opposite));
+  }
+  std::printf("%lld maps forwarded, %zu / %zu poses (capture path / direct path), %lld common: "
+              "largest difference %.3g m, %.3g in a quaternion component\n",
+              static_cast<long long>(checker->forwarded_maps), checker->checked_poses.size(),
+              checker->direct_poses.size(), static_cast<long long>(common), position_m,
+              orientation);
+  EXPECT_GT(common, 40);
+  EXPECT_GE(static_cast<std::int64_t>(checker->direct_poses.size()), common);
+  EXPECT_LE(position_m, 1e-6);
+  EXPECT_LE(orientation, 1e-6);  // about 2e-6 rad
+  // And the pose is the ken where the scene puts it: 1 m ahead on the optical axis.
+  ASSERT_FALSE(checker->checked_poses.empty());
+  const auto& last = checker->checked_poses.rbegin()->second;
+  EXPECT_NEAR(last[2], 1.0, 0.05);
 }
 
 TEST(CameraLoopback, FramesDroppedOnPurposeAreCountedAndDepthResumes) {
