@@ -1,30 +1,39 @@
-// Issue 16 section 3: no heap allocation per frame after warm-up in the hot paths of decode,
-// tracking and matching. This test program's malloc counts while a section is armed; the simulator
+// Issue 16 section 3: no heap allocation per frame after warm-up in the hot paths of capture,
+// decode, tracking, matching and the servo drive. This test program's malloc counts while a section is armed; the simulator
 // renders the ken on the manipulator trajectory (head still) once, and 1000 frames (500 depth maps)
-// go through each core as the components run them: RollingDecoder (sub-code refinement on, as
+// go through each core as the components run them: PatternSequencer (frame ids and timestamps
+// of a GigE Vision camera -> labels, as the camera component), RollingDecoder (sub-code
+// refinement on, as
 // launch_config/closed_loop.yaml), image moments + servo law, MatchingPipeline with the closed
-// loop's tuning.
+// loop's tuning; and 1000 cycles of the servo drive's DriveClient (command in, Modbus TCP
+// exchange with both axes, safety, feedback out) against the simulated amplifiers on loopback.
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "avs/camera/pattern_sequencer.hpp"
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/matching/pipeline.hpp"
+#include "avs/servo/amplifier_server.hpp"
+#include "avs/servo/drive_client.hpp"
 #include "avs/sim/simulator.hpp"
 #include "avs/tracking/moments.hpp"
 #include "avs/tracking/tracker.hpp"
 
 namespace {
 
-std::atomic<bool> g_counting{false};
+// Armed per thread: only the thread running the hot path counts (the servo test's simulated
+// amplifiers answer on a thread of their own).
+thread_local bool g_counting = false;
 std::atomic<long> g_allocations{0};
 
 void count() {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1);
+  if (g_counting) g_allocations.fetch_add(1);
 }
 
 }  // namespace
@@ -143,6 +152,37 @@ int decode_frames(decode::RollingDecoder& decoder, std::vector<float>& depth, in
   return maps;
 }
 
+TEST(HotPathAllocations, CapturePatternSequencer) {
+  // The camera component's per-frame core: label each frame from its id and timestamp, check
+  // each pair's sum against the previous pair's (the camera buffer itself is lent, not copied:
+  // docs/devices.md).
+  camera::PatternSequencer sequencer{camera::SequencerConfig{}};
+  long labelled = 0;
+  const auto push = [&](int k) {
+    camera::CameraFrame frame;
+    frame.frame_id = static_cast<std::uint64_t>(k % 65535) + 1;  // GigE Vision ids: 0 skipped
+    frame.timestamp_ns = 1'000'000LL * k;                        // 1000 fps
+    frame.image = recording().frame(k).image;
+    frame.token = static_cast<std::uint64_t>(k);
+    const camera::Released released = sequencer.push(frame);
+    for (int i = 0; i < released.count; ++i) {
+      const camera::ReleasedFrame& f = released.frames[static_cast<std::size_t>(i)];
+      labelled += f.reason == camera::DropReason::kNone ? 1 : 0;
+    }
+  };
+  for (int k = 0; k < kWarmUpFrames; ++k) push(k);
+  ASSERT_TRUE(sequencer.locked()) << "locked within " << kWarmUpFrames << " frames";
+  labelled = 0;
+  long allocations = 0;
+  {
+    CountAllocations counter;
+    for (int k = kWarmUpFrames; k < kWarmUpFrames + kCountedFrames; ++k) push(k);
+    allocations = counter.count();
+  }
+  EXPECT_GE(labelled, kCountedFrames - 2) << "labels over " << kCountedFrames << " frames";
+  EXPECT_EQ(allocations, 0) << "over " << kCountedFrames << " frames";
+}
+
 TEST(HotPathAllocations, DecodeWithSubcodeRefinement) {
   decode::RollingDecoder decoder(closed_loop_decoder());
   std::vector<float> depth(decoder.config().geometry.camera.width *
@@ -230,6 +270,52 @@ TEST(HotPathAllocations, MatchingClosedLoopTuning) {
   EXPECT_LE(allocations, 2L * (kCountedFrames / 2))
       << "over " << kCountedFrames / 2 << " depth maps, " << frames_allocating
       << " of them allocating";
+}
+
+TEST(HotPathAllocations, ServoDriveCycle) {
+  // The servo_drive component's cycle: the newest torque command in (set_command), one
+  // exchange per axis over Modbus TCP with every reply checked, the safety rules, the
+  // feedback out (cycle into the component's reused CycleResult). The amplifiers answer on
+  // their own thread (not counted); the test steps their plant between cycles.
+  constexpr double kPeriodS = 1e-3;
+  servo::AmplifierServer server{servo::AmplifierServerConfig{}};
+  server.step(kPeriodS);
+  servo::DriveClientConfig config = servo::default_drive_client_config("127.0.0.1", server.port());
+  // Generous: a loaded machine must not turn a slow reply into a link fault (its message and
+  // the reconnect allocate, as they may). The client's period must hold both timeouts; the
+  // test's own clock still advances 1 ms a cycle.
+  config.cycle_rate_hz = 2.0;
+  config.response_timeout_s = 0.2;
+  config.command_freshness.timeout_s = 10.0;
+  servo::DriveClient client(config);
+  client.connect();
+  double t = 0;
+  client.activate(t);
+  const std::vector<double> torque_nm{0.002, -0.002};
+  servo::CycleResult result;
+  long healthy = 0;
+  const auto cycle = [&](bool counted) {
+    t += kPeriodS;
+    long allocations = 0;
+    {
+      std::optional<CountAllocations> counter;
+      if (counted) counter.emplace();
+      (void)client.set_command(torque_nm, t, t);
+      client.cycle(t, result);
+      if (counter) allocations = counter->count();
+    }
+    healthy += result.link_ok && result.fault_message.empty() ? 1 : 0;
+    server.step(kPeriodS);
+    return allocations;
+  };
+  for (int i = 0; i < 100; ++i) (void)cycle(false);
+  ASSERT_EQ(result.axes.size(), 2u);
+  ASSERT_EQ(result.axes[0].state, servo::DriveState::operation_enabled);
+  healthy = 0;
+  long allocations = 0;
+  for (int i = 0; i < kCountedFrames; ++i) allocations += cycle(true);
+  EXPECT_EQ(healthy, kCountedFrames) << "every counted cycle exchanged with both axes";
+  EXPECT_EQ(allocations, 0) << "over " << kCountedFrames << " cycles";
 }
 
 }  // namespace

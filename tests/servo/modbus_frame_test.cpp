@@ -42,7 +42,8 @@ ReplyCheck check(const std::vector<std::uint8_t>& reply, std::uint16_t tid, std:
 }
 
 TEST(ModbusFrame, EncodesTheWriteReadRequest) {
-  const std::vector<std::uint8_t> adu = encode_tcp_request(0x0102, 2, cyclic_request());
+  const FrameBytes frame = encode_tcp_request(0x0102, 2, cyclic_request());
+  const std::vector<std::uint8_t> adu(frame.begin(), frame.end());
   const std::vector<std::uint8_t> expected = {0x01, 0x02, 0, 0, 0, 17, 2,    0x17, 0, 4, 0, 9,
                                               0,    0,    0, 3, 6, 0, 0x0F, 0x01, 0x23, 0, 7};
   EXPECT_EQ(adu, expected);

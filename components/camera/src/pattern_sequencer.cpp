@@ -225,7 +225,8 @@ bool PatternSequencer::structure_locks() const {
   if (run_.size() < 2 * static_cast<std::size_t>(pairs) + 2) return false;
   const std::size_t last = run_.size() - 1;
   int mismatches = 0;
-  std::vector<double> density(static_cast<std::size_t>(pairs));
+  std::vector<double>& density = density_scratch_;  // no allocation per frame once sized
+  density.assign(static_cast<std::size_t>(pairs), 0.0);
   for (int j = 0; j < pairs; ++j) {
     const std::size_t end = last - 2 * static_cast<std::size_t>(pairs - 1 - j);
     const Structure& pair = run_[end];
@@ -311,7 +312,8 @@ double PatternSequencer::couple_density(const CameraFrame& frame) const {
     return v > psi ? 1 : (v < -psi ? 0 : -1);
   };
   std::int64_t neighbours = 0, transitions = 0;
-  std::vector<int> previous_row(static_cast<std::size_t>(p.width), -1);
+  std::vector<int>& previous_row = row_scratch_;  // no allocation per frame once sized
+  previous_row.assign(static_cast<std::size_t>(p.width), -1);
   for (int y = 0; y < p.height; ++y) {
     int left = -1;
     for (int x = 0; x < p.width; ++x) {

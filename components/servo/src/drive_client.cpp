@@ -139,6 +139,7 @@ DriveClient::DriveClient(DriveClientConfig config) : config_(std::move(config)),
     if (!refusal.empty()) throw ConfigError(refusal);
   }
   command_nm_.assign(config_.axes.size(), 0.0);
+  command_snapshot_.assign(config_.axes.size(), 0.0);
   backoff_s_ = config_.reconnect_backoff_initial_s;
 }
 
@@ -449,7 +450,7 @@ DriveClient::ExchangeError DriveClient::tcp_transaction(std::uint8_t unit_id,
                                                         std::string& message, double timeout_s) {
   const int fd = modbus_get_socket(ctx_.get());
   transaction_id_ = static_cast<std::uint16_t>(transaction_id_ + 1);
-  const std::vector<std::uint8_t> adu = encode_tcp_request(transaction_id_, unit_id, request);
+  const FrameBytes adu = encode_tcp_request(transaction_id_, unit_id, request);
   for (std::size_t sent = 0; sent < adu.size();) {
     const ssize_t n = ::send(fd, adu.data() + sent, adu.size() - sent, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR) continue;
@@ -471,7 +472,14 @@ DriveClient::ExchangeError DriveClient::tcp_transaction(std::uint8_t unit_id,
   std::size_t pdu_bytes = 0;
   ReplyCheck check = check_tcp_reply_header(header, transaction_id_, unit_id, request, pdu_bytes);
   if (check.ok()) {
-    std::vector<std::uint8_t> pdu(pdu_bytes);
+    // Inline: no allocation per exchange. The header check allows only the lengths of the
+    // asked reply or an exception, both within a PDU's 253 bytes.
+    std::array<std::uint8_t, max_pdu_bytes> buffer;
+    if (pdu_bytes > buffer.size()) {
+      message = "bad reply: PDU of " + std::to_string(pdu_bytes) + " bytes";
+      return ExchangeError::bad_reply;
+    }
+    const std::span<std::uint8_t> pdu(buffer.data(), pdu_bytes);
     if (const ReadResult r = read_exact(fd, pdu, deadline); r != ReadResult::ok) return failed(r);
     check = check_reply_pdu(pdu, request, registers);
   }
@@ -637,9 +645,17 @@ void DriveClient::on_link_fault(double now_s, ExchangeError error, const std::st
 
 CycleResult DriveClient::cycle(double now_s) {
   CycleResult result;
-  result.axes.resize(axes_.size());
+  cycle(now_s, result);
+  return result;
+}
+
+void DriveClient::cycle(double now_s, CycleResult& result) {
+  result.link_ok = false;
+  result.link_fault = false;
+  result.fault_message.clear();
+  result.axes.assign(axes_.size(), AxisFeedback{});
   // Snapshot of the commands.
-  std::vector<double> command;
+  std::vector<double>& command = command_snapshot_;
   double stamp = 0;
   double arrival = 0;
   bool want_enabled = false;
@@ -647,7 +663,7 @@ CycleResult DriveClient::cycle(double now_s) {
   bool reset = false;
   {
     std::lock_guard lock(command_mutex_);
-    command = command_nm_;
+    std::copy(command_nm_.begin(), command_nm_.end(), command.begin());
     stamp = command_stamp_s_;
     arrival = command_arrival_s_;
     want_enabled = want_enabled_;
@@ -658,28 +674,28 @@ CycleResult DriveClient::cycle(double now_s) {
     result.link_fault = true;
     result.fault_message = fatal_error_;
     for (auto& fb : result.axes) fb.safety_reasons = safety_link_fault;
-    return result;
+    return;
   }
   if (!ctx_) {
     result.link_fault = true;
     for (auto& fb : result.axes) fb.safety_reasons = safety_link_fault;
     if (now_s < next_connect_s_) {
       result.fault_message = "servo_drive: link down, reconnecting";
-      return result;
+      return;
     }
     try {
       connect();
     } catch (const ConfigError& e) {
       fatal_error_ = e.what();
       result.fault_message = fatal_error_;
-      return result;
+      return;
     } catch (const std::exception& e) {
       std::lock_guard lock(command_mutex_);
       ++stats_.connect_failures;
       next_connect_s_ = now_s + backoff_s_;
       backoff_s_ = std::min(backoff_s_ * 2, config_.reconnect_backoff_max_s);
       result.fault_message = e.what();
-      return result;
+      return;
     }
     if (had_fault_) {
       std::lock_guard lock(command_mutex_);
@@ -723,7 +739,7 @@ CycleResult DriveClient::cycle(double now_s) {
         f = AxisFeedback{};
         f.safety_reasons = safety_link_fault;
       }
-      return result;
+      return;
     }
     fb.commanded_torque_nm = safe.torque_nm;
     fb.controlword = cw;
@@ -753,7 +769,6 @@ CycleResult DriveClient::cycle(double now_s) {
     std::lock_guard lock(command_mutex_);
     fault_reset_requested_ = false;
   }
-  return result;
 }
 
 }  // namespace avs::servo

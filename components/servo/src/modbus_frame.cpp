@@ -10,7 +10,7 @@ constexpr std::uint8_t fc_write_multiple = 0x10;
 constexpr std::uint8_t fc_write_read = 0x17;
 constexpr std::size_t exception_reply_bytes = 2;  ///< function | 0x80, exception code
 
-void put_u16(std::vector<std::uint8_t>& out, std::uint16_t value) {
+void put_u16(FrameBytes& out, std::uint16_t value) {
   out.push_back(static_cast<std::uint8_t>(value >> 8));
   out.push_back(static_cast<std::uint8_t>(value & 0xFF));
 }
@@ -75,15 +75,14 @@ RequestPdu write_read_registers_request(std::uint16_t write_address,
   return r;
 }
 
-std::vector<std::uint8_t> encode_tcp_request(std::uint16_t transaction_id, std::uint8_t unit_id,
-                                             const RequestPdu& request) {
-  std::vector<std::uint8_t> adu;
-  adu.reserve(mbap_header_bytes + request.bytes.size());
+FrameBytes encode_tcp_request(std::uint16_t transaction_id, std::uint8_t unit_id,
+                              const RequestPdu& request) {
+  FrameBytes adu;
   put_u16(adu, transaction_id);
   put_u16(adu, 0);  // protocol id: Modbus
   put_u16(adu, static_cast<std::uint16_t>(1 + request.bytes.size()));
   adu.push_back(unit_id);
-  adu.insert(adu.end(), request.bytes.begin(), request.bytes.end());
+  for (const std::uint8_t b : request.bytes) adu.push_back(b);
   return adu;
 }
 

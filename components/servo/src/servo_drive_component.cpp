@@ -457,7 +457,8 @@ class ServoDrive final : public runtime::Component {
 
   void run_cycle() {
     const runtime::Time now = context().now();
-    const CycleResult r = client_->cycle(now.seconds());
+    client_->cycle(now.seconds(), cycle_result_);  // reuses its memory: no allocation
+    const CycleResult& r = cycle_result_;
     if (!client_->fatal_error().empty()) throw ConfigError(client_->fatal_error());
     ++cycles_;
     const bool fault = r.link_fault || !r.fault_message.empty();
@@ -571,6 +572,7 @@ class ServoDrive final : public runtime::Component {
   std::string report_dir_;
   std::vector<std::string> names_;
   std::unique_ptr<DriveClient> client_;
+  CycleResult cycle_result_;  ///< run_cycle()'s, reused every cycle
   runtime::Duration period_{1'000'000};
   std::int64_t cycles_per_status_ = 100;
   runtime::TimerId timer_ = 0;

@@ -184,6 +184,9 @@ class PatternSequencer {
   std::array<std::vector<std::uint16_t>, 2> sums_;
   std::array<std::int64_t, 2> sum_position_{-1, -1};
   std::vector<std::uint16_t> scratch_;
+  // Scratch of the const structure measures (hunting), kept so that no frame allocates.
+  mutable std::vector<double> density_scratch_;
+  mutable std::vector<int> row_scratch_;
 
   // Hunting: structure of the continuous run ending at the last frame.
   std::vector<Structure> run_;

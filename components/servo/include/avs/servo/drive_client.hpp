@@ -160,6 +160,9 @@ class DriveClient {
 
   /// One cyclic exchange with every axis at time now_s (same time base as the stamps).
   CycleResult cycle(double now_s);
+  /// The same into `result`, reusing its memory: a healthy cycle allocates nothing once
+  /// `result` has held one (issue 16 section 3; the servo_drive component's form).
+  void cycle(double now_s, CycleResult& result);
 
   LinkStatistics statistics() const;
   CommandStatistics command_statistics() const;
@@ -222,6 +225,7 @@ class DriveClient {
 
   mutable std::mutex command_mutex_;  ///< guards the fields below and stats_
   std::vector<double> command_nm_;
+  std::vector<double> command_snapshot_;  ///< cycle()'s copy, sized once (no allocation)
   double command_stamp_s_ = std::numeric_limits<double>::quiet_NaN();
   double command_arrival_s_ = std::numeric_limits<double>::quiet_NaN();
   double accept_after_s_ = -std::numeric_limits<double>::infinity();

@@ -4,18 +4,44 @@
 // axis, or claiming 0xFFFF bytes, was taken as the answer. Pure functions, no I/O.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace avs::servo {
 
 inline constexpr std::size_t mbap_header_bytes = 7;  ///< transaction, protocol, length, unit
+inline constexpr std::size_t max_pdu_bytes = 253;   ///< Modbus application protocol, 4.1
+
+/// The bytes of a PDU or an ADU, held inline (a Modbus TCP ADU is at most 260 bytes), so that
+/// a cyclic exchange allocates nothing (issue 16 section 3).
+class FrameBytes {
+ public:
+  static constexpr std::size_t capacity = mbap_header_bytes + max_pdu_bytes;
+  void push_back(std::uint8_t b) {
+    if (size_ == capacity) throw std::length_error("Modbus frame longer than 260 bytes");
+    bytes_[size_++] = b;
+  }
+  const std::uint8_t* data() const { return bytes_.data(); }
+  std::size_t size() const { return size_; }
+  bool empty() const { return size_ == 0; }
+  std::uint8_t front() const { return bytes_[0]; }
+  const std::uint8_t* begin() const { return bytes_.data(); }
+  const std::uint8_t* end() const { return bytes_.data() + size_; }
+  std::uint8_t operator[](std::size_t i) const { return bytes_[i]; }
+  std::span<const std::uint8_t> span() const { return {bytes_.data(), size_}; }
+
+ private:
+  std::array<std::uint8_t, capacity> bytes_{};
+  std::size_t size_ = 0;
+};
 
 /// One request PDU (function code first) and what its reply must carry.
 struct RequestPdu {
-  std::vector<std::uint8_t> bytes;
+  FrameBytes bytes;
   std::uint16_t read_count = 0;     ///< registers the reply carries (0x03, 0x17)
   std::uint16_t write_address = 0;  ///< 0x10: echoed by the reply
   std::uint16_t write_count = 0;    ///< 0x10: echoed by the reply
@@ -31,8 +57,8 @@ RequestPdu write_read_registers_request(std::uint16_t write_address,
                                         std::uint16_t read_address, std::uint16_t read_count);
 
 /// MBAP header (protocol id 0, length = unit id + PDU) followed by the PDU.
-std::vector<std::uint8_t> encode_tcp_request(std::uint16_t transaction_id, std::uint8_t unit_id,
-                                             const RequestPdu& request);
+FrameBytes encode_tcp_request(std::uint16_t transaction_id, std::uint8_t unit_id,
+                              const RequestPdu& request);
 
 enum class ReplyProblem : std::uint8_t {
   none,
