@@ -2,6 +2,7 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <netinet/tcp.h>
 #include <sys/select.h>
 #include <sys/socket.h>
 
@@ -119,6 +120,11 @@ ServerCounters AmplifierServer::counters() const {
   return counters_;
 }
 
+void AmplifierServer::delay_next_replies(int count, double seconds) {
+  next_replies_delay_s_ = seconds;
+  delayed_replies_left_ = count;
+}
+
 void AmplifierServer::set_reply_delay(double seconds) {
   reply_delay_s_ = seconds;
 }
@@ -165,6 +171,11 @@ void AmplifierServer::io_loop() {
     if (FD_ISSET(listen_socket_.get(), &readable)) {
       const int fd = ::accept(listen_socket_.get(), nullptr, nullptr);
       if (fd >= 0) {
+        // Each reply goes out at once, as a drive's Modbus TCP server sends it: with Nagle's
+        // algorithm a reply right after a late one waited for the client's delayed ACK
+        // (about 40 ms), so one late reply made the next late too.
+        const int one = 1;
+        (void)::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
         clients_.emplace_back(fd);
         std::lock_guard lock(mutex_);
         ++counters_.connections_accepted;
@@ -201,7 +212,11 @@ void AmplifierServer::handle_request(const std::uint8_t* query, int length) {
     ++counters_.dropped_requests;
     return;
   }
-  const double delay = reply_delay_s_;
+  double delay = reply_delay_s_;
+  if (delayed_replies_left_ > 0) {
+    --delayed_replies_left_;
+    delay += next_replies_delay_s_;
+  }
   if (delay > 0) std::this_thread::sleep_for(std::chrono::duration<double>(delay));
 
   std::unique_lock lock(mutex_);

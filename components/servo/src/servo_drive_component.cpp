@@ -406,6 +406,8 @@ class ServoDrive final : public runtime::Component {
             {"commands_before_activation", std::to_string(c.before_activation)},
             {"exchanges", std::to_string(l.exchanges)},
             {"timeouts", std::to_string(l.timeouts)},
+            {"missed_cycles", std::to_string(l.missed_cycles)},
+            {"late_replies", std::to_string(l.late_replies)},
             {"exceptions", std::to_string(l.exceptions)},
             {"stale_replies", std::to_string(l.stale_replies)},
             {"bad_replies", std::to_string(l.bad_replies)},
@@ -472,6 +474,7 @@ class ServoDrive final : public runtime::Component {
       if (first_fault_message_.empty()) first_fault_message_ = r.fault_message;
     }
     if (!fault && last_fault_) log().info("link and drives healthy again");
+    if (!fault && !r.link_ok) report_missed_cycle(now.seconds());
     last_message_ = fault ? r.fault_message : std::string();
     const bool changed = cycles_ == 1 || fault != last_fault_ || r.link_ok != last_link_ok_;
     last_fault_ = fault;
@@ -480,6 +483,19 @@ class ServoDrive final : public runtime::Component {
     if (r.link_ok) publish_joint_states(now, r);
     if (changed || cycles_ % cycles_per_status_ == 0) publish_status(now, r);
     if (!report_dir_.empty()) record(now, r, fault);
+  }
+
+  /// A reply later than the response timeout, once: counted (missed_cycles on /diagnostics)
+  /// and logged at most once a second of the graph's clock with the count since the last line.
+  void report_missed_cycle(double now_s) {
+    ++missed_since_log_;
+    if (now_s - last_missed_log_s_ < 1.0) return;
+    log().warn(missed_since_log_,
+               " axis repl(ies) later than the response timeout since the last report: each a "
+               "missed cycle (the drive keeps the last torque for that period); a second in a "
+               "row on an axis is a link fault (missed_cycles on /diagnostics)");
+    missed_since_log_ = 0;
+    last_missed_log_s_ = now_s;
   }
 
   void publish_joint_states(runtime::Time now, const CycleResult& r) {
@@ -556,7 +572,8 @@ class ServoDrive final : public runtime::Component {
     yaml << "cycles: " << cycles_ << "\nlink_fault_cycles: " << link_fault_cycles_
          << "\nfirst_link_fault_s: " << first_link_fault_s_
          << "\nlast_link_fault_s: " << last_link_fault_s_ << "\nexchanges: " << s.exchanges
-         << "\ntimeouts: " << s.timeouts << "\nexceptions: " << s.exceptions
+         << "\ntimeouts: " << s.timeouts << "\nmissed_cycles: " << s.missed_cycles
+         << "\nlate_replies: " << s.late_replies << "\nexceptions: " << s.exceptions
          << "\nstale_replies: " << s.stale_replies << "\nbad_replies: " << s.bad_replies
          << "\nerrors: " << s.errors
          << "\nreconnects: " << s.reconnects << "\nconnect_failures: " << s.connect_failures
@@ -573,6 +590,8 @@ class ServoDrive final : public runtime::Component {
   std::vector<std::string> names_;
   std::unique_ptr<DriveClient> client_;
   CycleResult cycle_result_;  ///< run_cycle()'s, reused every cycle
+  std::int64_t missed_since_log_ = 0;
+  double last_missed_log_s_ = -1e300;
   runtime::Duration period_{1'000'000};
   std::int64_t cycles_per_status_ = 100;
   runtime::TimerId timer_ = 0;

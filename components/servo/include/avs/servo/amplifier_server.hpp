@@ -63,6 +63,8 @@ class AmplifierServer {
 
   // Fault injection.
   void set_reply_delay(double seconds);  ///< every reply is sent this much later
+  /// The next `count` replies are sent `seconds` later (a late reply now and then).
+  void delay_next_replies(int count, double seconds);
   void drop_connections();               ///< closes every client connection now
   void set_silent(bool silent);          ///< requests are read and never answered
   void set_stalled(bool stalled);        ///< sockets are not read (requests queue up)
@@ -89,6 +91,8 @@ class AmplifierServer {
   std::atomic<bool> silent_{false};
   std::atomic<bool> stalled_{false};
   std::atomic<double> reply_delay_s_{0.0};
+  std::atomic<int> delayed_replies_left_{0};
+  std::atomic<double> next_replies_delay_s_{0.0};
   std::thread io_thread_;
   std::thread step_thread_;
 };

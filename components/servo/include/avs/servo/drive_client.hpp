@@ -107,6 +107,12 @@ struct CycleResult {
 struct LinkStatistics {
   std::uint64_t exchanges = 0;  ///< successful, checked axis exchanges
   std::uint64_t timeouts = 0;
+  /// TCP: axis exchanges whose reply missed the response timeout once (issue 16 section 3):
+  /// the cycle goes on without that axis's feedback, the drive keeps the torque last written
+  /// for that period, no link fault. A second miss in a row (no valid reply for 2 periods), or
+  /// a miss while a late reply is still due, is a link fault.
+  std::uint64_t missed_cycles = 0;
+  std::uint64_t late_replies = 0;  ///< replies that came after their timeout: read and dropped
   std::uint64_t exceptions = 0;     ///< Modbus exception replies
   std::uint64_t stale_replies = 0;  ///< echo counter mismatch
   /// Replies that do not answer the request: wrong unit id, transaction or protocol id,
@@ -185,6 +191,7 @@ class DriveClient {
     AxisFeedback last;    ///< last good feedback
     double last_time_s = 0;  ///< when `last` was read
     int reset_phase = 0;  ///< fault reset edge: 0 write bit 7 low, 1 write bit 7 high
+    int missed_in_a_row = 0;  ///< exchanges whose reply missed the timeout, consecutively
     FaultLatch latch;
   };
   enum class ExchangeError : std::uint8_t { none, timeout, exception, stale, bad_reply, io };
@@ -221,6 +228,9 @@ class DriveClient {
   double backoff_s_ = 0;
   bool had_fault_ = false;
   std::uint16_t transaction_id_ = 0;  ///< of our own TCP requests
+  /// A request whose reply missed its timeout: that reply may still come, before the next.
+  bool late_reply_due_ = false;
+  std::uint16_t late_transaction_id_ = 0;
   std::string fatal_error_;  ///< configuration mismatch found on reconnect: no more retries
 
   mutable std::mutex command_mutex_;  ///< guards the fields below and stats_
