@@ -26,6 +26,13 @@ grep -q "^Publisher count: 1$" "$out/info" || fail "topic info: publisher count"
 grep -q "^Subscription count: 2$" "$out/info" || fail "topic info: subscription count"
 grep -q "^  QoS: reliable, volatile, keep_last 10$" "$out/info" || fail "topic info -v lacks QoS"
 "$avs" --version | grep -q "^avs [0-9]*\.[0-9]*\.[0-9]*$" || fail "avs --version"
+# avs components: ROS type names, the DDS names only with -v (issue 18 section 4).
+"$avs" components decode > "$out/components"
+grep -q "^  publishes depth -> /depth/image \[sensor_msgs/msg/Image\]$" "$out/components" ||
+  fail "avs components: no ROS type name"
+! grep -q "dds_" "$out/components" || fail "avs components: a DDS name without -v"
+"$avs" components -v decode | grep -q "\[sensor_msgs/msg/Image, DDS sensor_msgs::msg::dds_::Image_\]$" ||
+  fail "avs components -v: no DDS name"
 
 "$avs" topic echo /chatter -n 3 > "$out/echo"
 cat "$out/echo"

@@ -7,6 +7,7 @@
 #include "avs/graph/graph.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/container.hpp"
+#include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
 #include "graph_loading.hpp"
@@ -51,8 +52,15 @@ void add_components_command(Command& app) {
   auto* cmd =
       app.add_subcommand("components", "List component types with their parameters and topics");
   static std::string only;
+  static bool verbose = false;
   cmd->add_option("type", only, "show only this type");
+  cmd->add_flag("-v,--verbose", verbose, "DDS type names too");
   cmd->callback([] {
+    // ROS names where a person reads (issue 18 section 4); the DDS name only with -v.
+    const auto type_text = [](const std::string& dds_type) {
+      const std::string ros = runtime::to_ros_type_name(dds_type);
+      return verbose ? ros + ", DDS " + dds_type : ros;
+    };
     bool found = false;
     for (const auto* c : runtime::ComponentRegistry::instance().all()) {
       if (!only.empty() && c->spec.type != only) continue;
@@ -66,12 +74,12 @@ void add_components_command(Command& app) {
         std::cout << "  " << p.description << "\n";
       }
       for (const auto& p : c->spec.publishes) {
-        std::cout << "  publishes " << p.name << " -> " << p.default_topic << " [" << p.dds_type
-                  << "]\n";
+        std::cout << "  publishes " << p.name << " -> " << p.default_topic << " ["
+                  << type_text(p.dds_type) << "]\n";
       }
       for (const auto& p : c->spec.subscribes) {
-        std::cout << "  subscribes " << p.name << " <- " << p.default_topic << " [" << p.dds_type
-                  << "]\n";
+        std::cout << "  subscribes " << p.name << " <- " << p.default_topic << " ["
+                  << type_text(p.dds_type) << "]\n";
       }
     }
     if (!found) {
