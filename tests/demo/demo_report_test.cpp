@@ -106,4 +106,39 @@ TEST(Demo, ShortRunMakesAReportFromItsOwnData) {
   fs::remove(log + ".err");
 }
 
+TEST(Demo, RealtimePacesSimulatedTimeByTheWallClockAndSaysSo) {
+  // `avs demo --realtime 0.05` (issue 16 section 4): the loop paced by the wall clock, never
+  // faster than the factor asked for (a slow machine only makes it slower: no speed is
+  // asserted), and the report says which factor was used.
+  const fs::path dir = fs::temp_directory_path() / ("avs-demo-rt-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const std::string log = dir.string() + ".log";
+  const int status = avs::testing::run_avs(
+      {"demo", "--seconds", "0.2", "--realtime", "0.05", "--out", dir.string()}, log,
+      log + ".err");
+  const std::string output = read_file(log) + read_file(log + ".err");
+  ASSERT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("paced by the wall clock at 0.05 x real time"), std::string::npos)
+      << output;
+  EXPECT_NE(output.find("Notes: paced by the wall clock at 0.05 x real time"), std::string::npos)
+      << output;
+  EXPECT_NE(read_file(dir / "index.html").find("paced by the wall clock at 0.05 x real time"),
+            std::string::npos);
+  const avs::report::Summary s = avs::report::compute_summary(avs::report::load_run(dir));
+  ASSERT_TRUE(std::isfinite(s.real_time_factor)) << output;
+  // First to last row: within a frame period of the pacing (10 %), never lockstep's pace.
+  EXPECT_LE(s.real_time_factor, 0.05 * 1.1) << output;
+  EXPECT_GT(s.frames, 10) << output;
+  fs::remove_all(dir);
+
+  // A factor out of range is refused with the reason.
+  const int refused = avs::testing::run_avs({"demo", "--realtime", "2"}, log, log + ".err");
+  EXPECT_EQ(refused, 2);
+  EXPECT_NE(read_file(log + ".err").find("--realtime 2: expected a factor in (0, 1] or auto"),
+            std::string::npos)
+      << read_file(log + ".err");
+  fs::remove(log);
+  fs::remove(log + ".err");
+}
+
 }  // namespace

@@ -115,6 +115,12 @@ ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progre
   auto graph = load_or_report(closed_loop_graph().string(), words);
   if (!graph) return outcome;
   graph->domain_id = choose_closed_loop_domain(run, progress);
+  if (run.realtime_factor) {
+    // Paced by the wall clock (docs/graphs.md, clock: mode realtime): the camera does not wait
+    // for decode any more, stages that fall behind skip to the newest input and count it.
+    graph->clock.mode = graph::ClockSpec::Mode::realtime;
+    graph->clock.real_time_factor = *run.realtime_factor;
+  }
   const graph::ContainerSpec& spec = graph->containers.front();
 
   // Ctrl-C / SIGTERM go to a waiter thread that stops the container: the components are

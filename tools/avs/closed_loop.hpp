@@ -7,6 +7,7 @@
 #include <atomic>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -22,6 +23,9 @@ struct ClosedLoopRun {
   bool tracking = true;                   ///< false: the head holds still (Sec. 7.1.2)
   bool code_correction = true;            ///< Algorithm 1 on/off (Sec. 7.3)
   double duration_s = 3.0;                ///< simulated seconds
+  /// Set: simulated time paced by the wall clock at this factor (the graph's clock in
+  /// `realtime` mode, issue 16 section 4) instead of lockstep.
+  std::optional<double> realtime_factor;
   std::string notes;
   std::map<std::string, std::string> extra_args;  ///< more graph arguments NAME -> VALUE
   std::filesystem::path dir;                      ///< run folder

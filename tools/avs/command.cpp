@@ -44,6 +44,16 @@ Option* Option::capture_default_str() {
   return this;
 }
 
+Option* Option::optional_value(std::string when_alone) {
+  option_->expected(0, 1);
+  option_->default_str(std::move(when_alone));
+  return this;
+}
+
+bool Option::given() const {
+  return option_->count() > 0;
+}
+
 Option* Option::check_member(std::vector<std::string> allowed) {
   option_->check(CLI::IsMember(std::move(allowed)));
   return this;

@@ -1,11 +1,17 @@
 // avs demo: the main job. The simulated closed loop of the paper (projector-camera with
 // Gray-code depth at 500 Hz, active tracking by the pan/tilt head, model matching of the
-// kendama's ken on the manipulator trajectory) in sim-time lockstep, with progress, the
-// results table beside the paper's figures, and the report folder (figures, index.html).
+// kendama's ken on the manipulator trajectory) in sim-time lockstep (or, with --realtime,
+// paced by the wall clock), with progress, the results table beside the paper's figures, and
+// the report folder (figures, index.html).
+#include <algorithm>
 #include <cctype>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <ctime>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "avs/report/report.hpp"
@@ -42,6 +48,48 @@ std::string page_object_query(const std::string& object) {
   return query;
 }
 
+std::string format_factor(double factor) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", factor);
+  return text;
+}
+
+/// `--realtime FACTOR`: the factor, or with `auto` 0.8 x the real-time factor a 0.2 s lockstep
+/// run of the same loop reaches here (the fastest pace this machine sustains, with a margin);
+/// nullopt after saying what is wrong.
+std::optional<double> realtime_factor(const std::string& text, const ClosedLoopRun& run,
+                                      std::ostream& err) {
+  if (text != "auto" && !text.empty()) {
+    char* end = nullptr;
+    const double f = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !(f > 0.0 && f <= 1.0)) {
+      err << "avs demo: --realtime " << text << ": expected a factor in (0, 1] or auto\n";
+      return std::nullopt;
+    }
+    return f;
+  }
+  ClosedLoopRun probe = run;
+  probe.duration_s = 0.2;
+  probe.realtime_factor.reset();
+  probe.dir = run.dir / "realtime_probe";
+  err << "avs demo: --realtime auto: measuring this machine's pace with 0.2 s of lockstep\n";
+  const auto started = std::chrono::steady_clock::now();
+  const ClosedLoopOutcome outcome = run_closed_loop(probe, err);
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::error_code ignored;
+  std::filesystem::remove_all(probe.dir, ignored);
+  if (outcome.status != 0 || outcome.interrupted || !(wall_s > 0.0)) {
+    err << "avs demo: --realtime auto: the measuring run failed; give a factor\n";
+    return std::nullopt;
+  }
+  // Start-up (model loading, connecting) is in wall_s too: the estimate errs on the slow side.
+  const double factor = std::min(1.0, 0.8 * probe.duration_s / wall_s);
+  err << "avs demo: --realtime auto: 0.2 s of lockstep took " << format_factor(wall_s)
+      << " s here; pacing at " << format_factor(factor) << " x real time\n";
+  return factor;
+}
+
 }  // namespace
 
 void add_demo_command(Command& app) {
@@ -65,6 +113,13 @@ void add_demo_command(Command& app) {
   cmd->add_flag("--no-tracking", no_tracking, "the head holds still (Sec. 7.1.2)");
   static LiveViewFlags view;
   add_live_view_options(cmd, view, "the run");
+  static std::string realtime;
+  static Option* realtime_option = nullptr;
+  realtime_option = cmd->add_option("--realtime", realtime,
+                  "pace simulated time by the wall clock at FACTOR x real time (0 < FACTOR <= 1) "
+                  "instead of lockstep; `auto` (or no value): 0.8 x the factor this machine "
+                  "reaches in a 0.2 s lockstep run of the same loop")
+      ->optional_value("auto");
   static std::string calibration;
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
@@ -79,8 +134,22 @@ void add_demo_command(Command& app) {
     // Absolute: the report runs gnuplot inside the run folder.
     run.dir = std::filesystem::absolute(out.empty() ? default_run_dir("demo")
                                                     : std::filesystem::path(out));
-    std::cerr << "avs demo: simulated closed loop, " << run.duration_s << " s of sim time in "
-              << "lockstep (graph " << closed_loop_graph().string() << ", scene " << run.scene
+    if (realtime_option->given()) {
+      const std::optional<double> factor = realtime_factor(realtime, run, std::cerr);
+      if (!factor) {
+        exit_status() = 2;
+        return;
+      }
+      run.realtime_factor = *factor;
+      run.notes = "paced by the wall clock at " + format_factor(*factor) +
+                  " x real time (avs demo --realtime)";
+    }
+    std::cerr << "avs demo: simulated closed loop, " << run.duration_s << " s of sim time "
+              << (run.realtime_factor
+                      ? "paced by the wall clock at " + format_factor(*run.realtime_factor) +
+                            " x real time"
+                      : std::string("in lockstep"))
+              << " (graph " << closed_loop_graph().string() << ", scene " << run.scene
               << "); Ctrl-C ends it early with a partial report\n";
     const std::unique_ptr<view::View> live =
         view.enabled ? start_live_view(view, choose_closed_loop_domain(run, std::cerr), "",

@@ -141,8 +141,9 @@ int report_main(const fs::path& dir, std::ostream& out, std::ostream& err,
     out << "avs report: " << report.info.scenario << " (" << report.info.object << "), "
         << format_figure(report.summary.frames) << " depth updates\n\n"
         << format_comparison_table(report.info.scenario, report.summary)
-        << format_run_clocks(report.summary) << "\n"
-        << kPaperNote << "\n\n";
+        << format_run_clocks(report.summary) << "\n";
+    if (!report.info.notes.empty()) out << "Notes: " << report.info.notes << "\n";
+    out << kPaperNote << "\n\n";
     for (const std::string& warning : report.warnings) err << "warning: " << warning << "\n";
     for (const SkippedPlot& s : report.plots.skipped) {
       out << "not made: " << s.png << " (" << s.reason << ")\n";
