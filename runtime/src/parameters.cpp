@@ -141,7 +141,8 @@ ParamSpec ParamSpec::live() && {
 
 std::string format_number(double v) {
   // Whole numbers as integers ("10000000", not "1e+07"), as a person writes them.
-  if (std::isfinite(v) && v == std::floor(v) && std::abs(v) < 1e15) {
+  // Up to 2^53, where a double still holds every integer (a range's 1e15 bound included).
+  if (std::isfinite(v) && v == std::floor(v) && std::abs(v) <= 9007199254740992.0) {
     return std::to_string(static_cast<long long>(v));
   }
   char buf[64];

@@ -93,6 +93,9 @@ TEST(ParamText, YamlTextReadsBackAsTheSameValue) {
   EXPECT_EQ(to_yaml_text(ParamValue{std::vector<double>{1, 2.5}}), "[1, 2.5]");
   EXPECT_EQ(format_number(1e7), "10000000");  // whole numbers as integers
   EXPECT_EQ(format_number(1e-6), "1e-06");
+  // A range's bound of 1e15 (sim_scene's seed) printed "1e+15" (issue 18 section 4).
+  EXPECT_EQ(format_number(1e15), "1000000000000000");
+  EXPECT_EQ(format_number(-9007199254740992.0), "-9007199254740992");
 }
 
 TEST(ParamSpec, LiveMarksDynamicAndFloatDefaultsKeepTheirDecimal) {

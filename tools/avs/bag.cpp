@@ -310,7 +310,7 @@ void add_bag_command(Command& app) {
   play->add_option("--remap", pl.remaps, "publish topic FROM as TO (FROM:=TO), repeatable");
   play->add_flag(
       "--clock", pl.options.clock,
-      "publish /clock (rosgraph_msgs/Clock) from the bag's log time, so a sim-time graph "
+      "publish /clock (rosgraph_msgs/msg/Clock) from the bag's log time, so a sim-time graph "
       "follows the recording");
   play->add_option("--clock-period", pl.options.clock_period_s,
                    "with --clock: publish /clock at least every S seconds of bag time")

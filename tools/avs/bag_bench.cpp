@@ -55,7 +55,7 @@ BenchArgs parse_args(const std::vector<std::string>& raw) {
     std::printf(
         "avs bench bag [--duration=S] [--fps=N] [--size=PX] [--compression=none,lz4,zstd]\n"
         "              [--dir=DIR] [--keep] [--domain=ID] [--publisher-history=N]\n"
-        "Records /bench_bag/pattern_frames (avs_msgs/PatternFrame, PXxPX mono8, N fps) with\n"
+        "Records /bench_bag/pattern_frames (avs_msgs/msg/PatternFrame, PXxPX mono8, N fps) with\n"
         "/bench_bag/target (1 kHz), /bench_bag/torque (1 kHz) and /bench_bag/match (100 Hz) from "
         "a\n"
         "publisher process for S seconds per compression; files go to DIR (default $TMPDIR or "

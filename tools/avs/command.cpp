@@ -44,9 +44,8 @@ Option* Option::capture_default_str() {
   return this;
 }
 
-Option* Option::optional_value(std::string when_alone) {
+Option* Option::optional_value() {
   option_->expected(0, 1);
-  option_->default_str(std::move(when_alone));
   return this;
 }
 

@@ -34,8 +34,8 @@ class Option {
   Option* check_range(double min, double max);
   /// The value must name an existing file (CLI::ExistingFile).
   Option* check_existing_file();
-  /// The value may be left out (`--realtime` or `--realtime 0.5`): then it is `when_alone`.
-  Option* optional_value(std::string when_alone);
+  /// The value may be left out (`--realtime` or `--realtime 0.5`): then it is empty.
+  Option* optional_value();
   /// Whether the option was on the command line.
   bool given() const;
 

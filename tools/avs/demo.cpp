@@ -116,10 +116,10 @@ void add_demo_command(Command& app) {
   static std::string realtime;
   static Option* realtime_option = nullptr;
   realtime_option = cmd->add_option("--realtime", realtime,
-                  "pace simulated time by the wall clock at FACTOR x real time (0 < FACTOR <= 1) "
-                  "instead of lockstep; `auto` (or no value): 0.8 x the factor this machine "
-                  "reaches in a 0.2 s lockstep run of the same loop")
-      ->optional_value("auto");
+                  "[FACTOR] pace simulated time by the wall clock at FACTOR x real time "
+                  "(0 < FACTOR <= 1) instead of lockstep; `auto` or no value: 0.8 x the factor "
+                  "this machine reaches in a 0.2 s lockstep run of the same loop")
+      ->optional_value();
   static std::string calibration;
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "

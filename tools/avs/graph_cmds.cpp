@@ -55,6 +55,8 @@ void add_components_command(Command& app) {
   static bool verbose = false;
   cmd->add_option("type", only, "show only this type");
   cmd->add_flag("-v,--verbose", verbose, "DDS type names too");
+  cmd->footer("[live]: `avs param set` changes it while the graph runs; the others need a "
+              "restart (docs/operate.md).");
   cmd->callback([] {
     // ROS names where a person reads (issue 18 section 4); the DDS name only with -v.
     const auto type_text = [](const std::string& dds_type) {
@@ -71,7 +73,8 @@ void add_components_command(Command& app) {
                   << ") = " << runtime::to_string(p.default_value);
         if (!p.unit.empty()) std::cout << " " << p.unit;
         std::cout << runtime::range_text(p.min, p.max);
-        std::cout << "  " << p.description << "\n";
+        // Which ones `avs param set` changes while the graph runs (issue 18 section 1).
+        std::cout << (p.dynamic ? "  [live]" : "") << "  " << p.description << "\n";
       }
       for (const auto& p : c->spec.publishes) {
         std::cout << "  publishes " << p.name << " -> " << p.default_topic << " ["

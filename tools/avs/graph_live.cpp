@@ -19,6 +19,7 @@
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/error.hpp"
 #include "avs/runtime/raw_topic.hpp"
+#include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
 #include "diagnostic_msgs.h"
@@ -117,7 +118,10 @@ bool partitions_meet(const std::vector<std::string>& a, const std::vector<std::s
 /// Why a publisher and a subscriber of one topic cannot match ("" when they can).
 std::vector<std::string> mismatch(const Endpoint& pub, const Endpoint& sub) {
   std::vector<std::string> why;
-  if (pub.type != sub.type) why.push_back("types differ: " + pub.type + " vs " + sub.type);
+  if (pub.type != sub.type) {
+    why.push_back("types differ: " + runtime::to_ros_type_name(pub.type) + " vs " +
+                  runtime::to_ros_type_name(sub.type));
+  }
   if (sub.qos.reliable && !pub.qos.reliable) {
     why.push_back("the subscriber requires RELIABLE, the publisher offers BEST_EFFORT");
   }
@@ -151,6 +155,7 @@ struct Options {
   int domain = 0;  // add_domain_option
   double duration_s = 3.0;
   bool no_rates = false;  // --no-rates
+  bool verbose = false;   // -v: DDS names too
 };
 
 int run_graph_view(const Options& o) {
@@ -298,6 +303,8 @@ int run_graph_view(const Options& o) {
     // Services (the parameter services' rq/..Request, rr/..Reply) are not topics; `avs node
     // info` lists them.
     if (e.topic.rfind("rq/", 0) == 0 || e.topic.rfind("rr/", 0) == 0) continue;
+    // Nor is the DDS-only ros_discovery_info (as in `avs topic list`); -v shows it.
+    if (!o.verbose && e.topic == "ros_discovery_info") continue;
     topics.insert(e.topic);
     (key.back() == 'w' ? by_topic_pub : by_topic_sub)[e.topic].push_back(&e);
   }
@@ -318,7 +325,10 @@ int run_graph_view(const Options& o) {
                 << "     ";
     }
     const Endpoint* any = !ps.empty() ? ps.front() : ss.front();
-    std::cout << any->type << "\n";
+    // ROS names where a person reads (issue 18 section 4); the DDS ones with -v.
+    std::cout << runtime::to_ros_type_name(any->type);
+    if (o.verbose) std::cout << "  (DDS " << t << ", " << any->type << ")";
+    std::cout << "\n";
     for (const auto* p : ps)
       std::cout << "      pub " << who(p->participant) << " [" << p->qos.text << "]\n";
     for (const auto* s : ss)
@@ -356,6 +366,7 @@ void add_graph_command(Command& app) {
       ->capture_default_str()
       ->check_range(0.1, 3600);
   cmd->add_flag("--no-rates", o.no_rates, "do not subscribe to topics to measure rates");
+  cmd->add_flag("-v,--verbose", o.verbose, "DDS topic and type names too");
   cmd->footer(
       "Exit status 3 when a publisher and a subscriber of one topic cannot match.\n"
       "On a deployment: eval \"$(avs deploy env DEPLOY.yaml --host H)\"; avs graph");

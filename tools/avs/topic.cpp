@@ -109,14 +109,16 @@ class RawReader {
       auto it = topics.find(dds_name_);
       if (it != topics.end() && !it->second.publishers.empty()) break;
       if (Clock::now() > deadline) {
-        throw runtime::Error("no publisher of " + dds_name_ + " found within " +
-                             std::to_string(wait_s) + " s (see `avs topic list`)");
+        throw runtime::Error("no publisher of " + runtime::from_dds_topic_name(dds_name_) +
+                             " found within " + runtime::format_number(wait_s) +
+                             " s (see `avs topic list`)");
       }
     }
     const TopicInfo& info = topics.at(dds_name_);
     type_ = msg::find_type(info.type_name);
     if (type_ == nullptr) {
-      throw runtime::Error(dds_name_ + " has type " + info.type_name +
+      throw runtime::Error(runtime::from_dds_topic_name(dds_name_) + " has type " +
+                           runtime::to_ros_type_name(info.type_name) +
                            ", which this build does not know");
     }
     // Match what the publishers offer: reliable only if they all are.
@@ -198,6 +200,8 @@ void run_list(const CommonOptions& o, bool verbose) {
     // Services (rq/..Request, rr/..Reply: the parameter services) are not topics, as in
     // `ros2 topic list`; `avs param list` shows the nodes that offer them.
     if (name.rfind("rq/", 0) == 0 || name.rfind("rr/", 0) == 0) continue;
+    // Nor is the DDS-only ros_discovery_info (ros2 topic list hides it too); -v shows it.
+    if (!verbose && name == "ros_discovery_info") continue;
     // ROS names (`/chatter`) as ros2 topic list prints them; the DDS ones with -v.
     const std::string ros_name =
         name.rfind("rt/", 0) == 0 ? runtime::from_dds_topic_name(name) : name;
