@@ -350,6 +350,29 @@ TEST_F(GraphTest, DeepIncludeChainIsALocatedErrorNotACrash) {
   EXPECT_EQ(result.errors[0].where.line, 2);
 }
 
+TEST_F(GraphTest, IncludesThatDoubleAtEachLevelAreBoundedNotAFreeze) {
+  // Each file includes the next twice: 40 levels (within the depth limit of 64) meant 2^40
+  // file reads and a loader that never returned. The loader reads at most 1024 includes for a
+  // graph and says so once, at the include that crossed the budget.
+  const TempDir dir;
+  constexpr int kFiles = 40;
+  for (int i = 0; i < kFiles; ++i) {
+    std::ofstream out(dir.path / ("d" + std::to_string(i) + ".yaml"));
+    if (i + 1 < kFiles) {
+      out << "include:\n  - {file: d" << i + 1 << ".yaml}\n  - {file: d" << i + 1 << ".yaml}\n";
+    } else {
+      out << "args:\n  unused: {default: 0}\n";
+    }
+  }
+  const LoadResult result = load_graph((dir.path / "d0.yaml").string(), {});
+  std::size_t budget_errors = 0;
+  for (const Diagnostic& e : result.errors) {
+    budget_errors += e.message.find("more than 1024 includes read") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(budget_errors, 1u) << all_errors(result);
+  EXPECT_FALSE(result.ok());
+}
+
 TEST_F(GraphTest, HugeValuesAreNotEchoedWhole) {
   const TempDir dir;
   const std::string type(100000, 'x');

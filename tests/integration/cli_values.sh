@@ -21,6 +21,12 @@ refused "--domain: Value 300 not in range" topic list --domain 300
 refused "--width: Value 100000 not in range" patterns --width 100000 --out /nonexistent
 refused "--seconds: a finite number is needed, got inf" demo --seconds inf
 refused "--max-gap: Value 0 not in range" bag play none.mcap --max-gap 0
+# Counts, windows, levels and durations that were accepted (an audit of issue 20, 2026-12-06).
+refused "--count: Value -5 not in range" topic echo /chatter -n -5
+refused "--window: Value 0 not in range" topic hz /chatter --window 0
+refused "--compression-level: Value 99999 not in range" bag record /chatter -o /tmp/x.mcap --compression-level 99999
+refused "--duration: Value -1 not in range" view --duration -1
+refused "--queue-depth: Value 0 not in range" view --queue-depth 0
 # The benchmarks' own options (bench::Options): the benchmark, option and range, never "stod".
 if "$avs" bench 2>/dev/null | grep -q '^servo'; then
   refused "avs bench servo: --rate wants a number in [1, 100000], got 'abc'" bench servo --rate abc

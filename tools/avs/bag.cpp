@@ -267,12 +267,16 @@ void add_bag_command(Command& app) {
   record->add_option("-o,--output", rec.options.output, "MCAP file to write")->required();
   record->add_option("--compression", rec.compression, "chunk compression: zstd, lz4 or none")
       ->capture_default_str();
-  record->add_option("--compression-level", rec.options.compression_level, "zstd level / lz4 level")
-      ->capture_default_str();
+  record->add_option("--compression-level", rec.options.compression_level,
+                     "zstd level (-7 to 22) / lz4 level (0 to 12; higher: lz4's HC mode)")
+      ->capture_default_str()
+      ->check_range(-7, 22);
   record->add_option("--chunk-size", rec.options.chunk_size_bytes, "uncompressed chunk size, bytes")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1024, 1 << 30);
   record->add_option("--max-size", rec.options.max_size_bytes,
-                     "start a new file (<stem>_1.mcap, ...) when one reaches BYTES (0: never)");
+                     "start a new file (<stem>_1.mcap, ...) when one reaches BYTES (0: never)")
+      ->check_range(0, 1e15);
   record
       ->add_option("--max-duration", rec.options.max_duration_s,
                    "start a new file when one covers S seconds (0: never)")

@@ -377,9 +377,11 @@ void add_topic_command(Command& app) {
   auto* echo =
       topic->add_subcommand("echo", "Print samples as YAML (images and clouds summarised)");
   add_common(echo, echo_o, true);
-  echo->add_option("-n,--count", echo_o.count, "print this many samples, then exit");
+  echo->add_option("-n,--count", echo_o.count, "print this many samples, then exit (0: all)")
+      ->check_range(0, 1e12);
   echo->add_option("--max-elements", yaml.max_list_elements,
-                   "longest list printed in full (0: all)");
+                   "longest list printed in full (0: all)")
+      ->check_range(0, 1e9);
   echo->callback([] {
     stop_on_interrupt();
     run_echo(echo_o, yaml);
@@ -390,7 +392,8 @@ void add_topic_command(Command& app) {
   auto* hz = topic->add_subcommand("hz", "Receive rate: mean, min/max/std of intervals");
   add_common(hz, hz_o, true);
   hz->add_option("-w,--window", hz_window, "intervals in the sliding window")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1, 1e7);
   hz->callback([] {
     stop_on_interrupt();
     run_rate(hz_o, false, hz_window);
@@ -400,7 +403,9 @@ void add_topic_command(Command& app) {
   static std::size_t bw_window = 1000;
   auto* bw = topic->add_subcommand("bw", "Bandwidth: bytes per second of serialised samples");
   add_common(bw, bw_o, true);
-  bw->add_option("-w,--window", bw_window, "messages in the sliding window")->capture_default_str();
+  bw->add_option("-w,--window", bw_window, "messages in the sliding window")
+      ->capture_default_str()
+      ->check_range(1, 1e7);
   bw->callback([] {
     stop_on_interrupt();
     run_rate(bw_o, true, bw_window);

@@ -69,7 +69,8 @@ void add_view_command(Command& app) {
       "view",
       "Foxglove WebSocket server (foxglove.websocket.v1) for the topics of a running graph");
   cmd->add_option("--port", a.port, "TCP port (0: any free port, printed at start)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0, 65535);
   cmd->add_option("--address", a.address, "address to listen on (0.0.0.0: every interface)")
       ->capture_default_str();
   add_domain_option(cmd, a.domain);
@@ -80,11 +81,13 @@ void add_view_command(Command& app) {
   cmd->add_option("--queue-depth", a.queue_depth,
                   "messages waiting per client and subscription; the oldest is dropped (and "
                   "counted on /diagnostics) when a slow client lets it fill")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1, 1e6);
   cmd->add_option("--web-root", a.web_root,
                   "folder of the page served at / (default: the one this build bundled)")
       ->capture_default_str();
-  cmd->add_option("--duration", a.duration_s, "stop after this many seconds (0: until Ctrl-C)");
+  cmd->add_option("--duration", a.duration_s, "stop after this many seconds (0: until Ctrl-C)")
+      ->check_range(0, 1e9);
   cmd->footer(
       "Every DDS topic with a publisher and a type this build knows is advertised with its "
       "ros2msg schema and encoding cdr; messages are forwarded as received from DDS. "

@@ -25,6 +25,7 @@
 #include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
+#include "avs/runtime/rejections.hpp"
 #include "avs/runtime/text.hpp"
 #include "avs/servo/amplifier_server.hpp"
 #include "avs/servo/drive_client.hpp"
@@ -214,7 +215,8 @@ class ServoDrive final : public runtime::Component {
         drive_status_(ctx.publisher<msgs::avs_msgs::DriveStatus>("drive_status")),
         own_thread_(ctx.param<bool>("own_thread")),
         rt_priority_(ctx.param<int>("rt_priority")),
-        report_dir_(ctx.param<std::string>("report_dir")) {
+        report_dir_(ctx.param<std::string>("report_dir")),
+        rejected_(ctx.log(), "/head/torque_command") {
     if (own_thread_ && ctx.uses_sim_time()) {
       throw ConfigError(
           "servo_drive: own_thread: true needs wall time; in sim time the cycle must run as a "
@@ -362,6 +364,21 @@ class ServoDrive final : public runtime::Component {
   void on_command(const msgs::avs_msgs::JointTorqueCommand& m) {
     const auto torques = runtime::as_span(m.torque_nm);
     const auto names = runtime::as_span(m.name);
+    // A command that cannot be taken whole is rejected, counted (rejected_samples) and logged
+    // (rate-limited); the last valid one stays until the stale-command rule zeroes it. Before,
+    // a NaN became 0 N m and a short or unnamed-and-long vector was cut or padded silently.
+    for (std::size_t j = 0; j < torques.size(); ++j) {
+      if (!std::isfinite(torques[j])) {
+        rejected_.reject("torque " + std::to_string(j) + " is not finite");
+        return;
+      }
+    }
+    if (names.empty() ? torques.size() != names_.size() : torques.size() != names.size()) {
+      rejected_.reject(std::to_string(torques.size()) + " torques for " +
+                       std::to_string(names.empty() ? names_.size() : names.size()) +
+                       (names.empty() ? " joints (no names: one per joint, in order)" : " names"));
+      return;
+    }
     std::vector<double> command(names_.size(), 0.0);
     if (names.empty()) {
       for (std::size_t i = 0; i < std::min(command.size(), torques.size()); ++i) {
@@ -401,7 +418,8 @@ class ServoDrive final : public runtime::Component {
   std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
     const LinkStatistics l = client_->statistics();
     const CommandStatistics c = client_->command_statistics();
-    return {{"commands_accepted", std::to_string(c.accepted)},
+    return {rejected_.diagnostic(),
+            {"commands_accepted", std::to_string(c.accepted)},
             {"commands_future_stamped", std::to_string(c.future_stamped)},
             {"commands_before_activation", std::to_string(c.before_activation)},
             {"exchanges", std::to_string(l.exchanges)},
@@ -578,6 +596,7 @@ class ServoDrive final : public runtime::Component {
          << "\nerrors: " << s.errors
          << "\nreconnects: " << s.reconnects << "\nconnect_failures: " << s.connect_failures
          << "\ncommands_future_stamped: " << client_->command_statistics().future_stamped
+         << "\nrejected_commands: " << rejected_.count()
          << "\nfirst_fault_message: \"" << first_fault_message_ << "\"\n";
     if (!csv || !yaml) log().error("cannot write the report to ", base, ".{csv,yaml}");
   }
@@ -599,6 +618,7 @@ class ServoDrive final : public runtime::Component {
   std::atomic<bool> stop_{false};
   std::atomic<bool> estop_{false};
   bool warned_unknown_joint_ = false;
+  runtime::SampleRejections rejected_;  ///< /head/torque_command samples not taken
   double last_refusal_log_s_ = -1e300;  ///< subscription callback only
   std::uint64_t future_stamped_logged_ = 0;
 

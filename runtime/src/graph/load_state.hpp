@@ -26,6 +26,8 @@ struct LoadState {
   Graph graph;
   Diagnostics diags;
   std::vector<std::string> include_stack;  ///< canonical paths, outermost first
+  std::size_t included_files = 0;          ///< includes read so far (a repeated file counts again)
+  bool include_budget_reported = false;
   std::map<std::string, SourceLocation> container_names;
   std::map<std::string, SourceLocation> component_names;
   std::vector<Endpoint> endpoints;

@@ -1,12 +1,14 @@
 // Small components for the servo graph tests (tests/integration_servo/):
 //   test_torque_step   - publishes a torque command schedule (zero, a step, zero), an
 //                        optional e-stop window and fault reset on the container clock,
-//                        optionally stamped ahead of the clock;
+//                        optionally stamped ahead of the clock, and malformed commands
+//                        (a NaN torque, fewer torques than names) in a window;
 //   test_head_recorder - records /sim/head_state and /head/joint_states to CSV files
 //                        <report_dir>/<name>_sim.csv and <name>_joints.csv on deactivate.
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 
 #include "avs/runtime/component.hpp"
 
@@ -44,7 +46,13 @@ class TestTorqueStep final : public runtime::Component {
                                        "publish one /head/fault_reset at this time (-1 = never)"),
                        ParamSpec::real("stamp_offset_s", 0.0, -1e6, 1e6, "s",
                                        "stamp the commands this much after the clock (a "
-                                       "sender clock ahead, if positive)")},
+                                       "sender clock ahead, if positive)"),
+                       ParamSpec::real("bad_from_s", -1.0, -1.0, std::nullopt, "s",
+                                       "from this time (-1 = never) until bad_until_s, "
+                                       "malformed commands: a NaN torque, then one torque "
+                                       "for two names, in turn"),
+                       ParamSpec::real("bad_until_s", -1.0, -1.0, std::nullopt, "s",
+                                       "end of the malformed commands")},
         .publishes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
                           "torque_command", "/head/torque_command", keep_last_1),
                       runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
@@ -64,7 +72,9 @@ class TestTorqueStep final : public runtime::Component {
         estop_at_s_(ctx.param<double>("estop_at_s")),
         estop_release_s_(ctx.param<double>("estop_release_s")),
         fault_reset_at_s_(ctx.param<double>("fault_reset_at_s")),
-        stamp_offset_(std::llround(ctx.param<double>("stamp_offset_s") * 1e9)) {
+        stamp_offset_(std::llround(ctx.param<double>("stamp_offset_s") * 1e9)),
+        bad_from_s_(ctx.param<double>("bad_from_s")),
+        bad_until_s_(ctx.param<double>("bad_until_s")) {
     const std::string names = ctx.param<std::string>("joint_names");
     for (std::size_t start = 0; start <= names.size();) {
       const std::size_t comma = std::min(names.find(',', start), names.size());
@@ -108,6 +118,13 @@ class TestTorqueStep final : public runtime::Component {
       runtime::set_string(msg->name._buffer[i], names_[i]);
       msg->torque_nm._buffer[i] = on ? torque_[i] : 0.0;
     }
+    if (bad_from_s_ >= 0 && t >= bad_from_s_ && t < bad_until_s_) {
+      if (bad_sent_++ % 2 == 0) {
+        msg->torque_nm._buffer[0] = std::numeric_limits<double>::quiet_NaN();
+      } else {
+        runtime::resize_sequence(msg->torque_nm, n > 0 ? n - 1 : 0);  // fewer torques than names
+      }
+    }
     command_.publish(std::move(msg));
   }
 
@@ -129,6 +146,9 @@ class TestTorqueStep final : public runtime::Component {
   double estop_release_s_;
   double fault_reset_at_s_;
   runtime::Duration stamp_offset_;
+  double bad_from_s_;
+  double bad_until_s_;
+  std::uint64_t bad_sent_ = 0;
   bool estop_sent_ = false;
   bool release_sent_ = false;
   bool reset_sent_ = false;
