@@ -25,6 +25,12 @@ grep -q "^Type: std_msgs/msg/String$" "$out/info" || fail "topic info lacks the 
 grep -q "^Publisher count: 1$" "$out/info" || fail "topic info: publisher count"
 grep -q "^Subscription count: 2$" "$out/info" || fail "topic info: subscription count"
 grep -q "^  QoS: reliable, volatile, keep_last 10$" "$out/info" || fail "topic info -v lacks QoS"
+# As ros2 topic info -v: each endpoint's node (from ros_discovery_info), endpoint type, GID.
+grep -q "^  Node name: talker$" "$out/info" || fail "topic info -v lacks the publisher's node"
+grep -q "^  Node name: local_listener$" "$out/info" || fail "topic info -v lacks a subscriber's node"
+grep -q "^  Node namespace: /$" "$out/info" || fail "topic info -v lacks the node namespace"
+grep -q "^  Endpoint type: PUBLISHER$" "$out/info" || fail "topic info -v lacks the endpoint type"
+grep -Eq "^  GID: [0-9a-f]{2}(\.[0-9a-f]{2}){15}$" "$out/info" || fail "topic info -v lacks the GID"
 "$avs" --version | grep -q "^avs [0-9]*\.[0-9]*\.[0-9]*$" || fail "avs --version"
 # avs components: ROS type names, the DDS names only with -v (issue 18 section 4).
 "$avs" components decode > "$out/components"

@@ -19,6 +19,7 @@
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/parameters.hpp"
 #include "avs/runtime/raw_topic.hpp"
+#include "avs/runtime/ros_discovery.hpp"
 #include "avs/runtime/topic_name.hpp"
 #include "commands.hpp"
 #include "dds_environment.hpp"
@@ -33,6 +34,7 @@ using Clock = std::chrono::steady_clock;
 struct EndpointInfo {
   std::string type_name;
   std::string qos;
+  runtime::Gid gid{};  ///< the endpoint's GUID (ros_discovery_info names its node by it)
 };
 
 struct TopicInfo {
@@ -85,7 +87,7 @@ std::map<std::string, TopicInfo> discover(const runtime::dds::Participant& parti
     TopicInfo& info = topics[e.topic];
     info.type_name = e.type_name;
     (e.is_writer ? info.publishers : info.subscribers)
-        .push_back({e.type_name, describe_qos(e.qos.get())});
+        .push_back({e.type_name, describe_qos(e.qos.get()), e.key});
   }
   return topics;
 }
@@ -232,8 +234,19 @@ TopicInfo find_topic(const runtime::dds::Participant& participant, const CommonO
   }
 }
 
-/// As `ros2 topic info [-v]`: the type, the endpoint counts, with -v each endpoint's QoS and
-/// the DDS names.
+/// "01.0f.7e..." as ros2 topic info -v prints a GID.
+std::string gid_text(const runtime::Gid& gid) {
+  std::string out;
+  char byte[4];
+  for (std::size_t i = 0; i < gid.size(); ++i) {
+    std::snprintf(byte, sizeof byte, i == 0 ? "%02x" : ".%02x", gid[i]);
+    out += byte;
+  }
+  return out;
+}
+
+/// As `ros2 topic info [-v]`: the type, the endpoint counts, with -v each endpoint's node
+/// (from ros_discovery_info, as ros2 reads it), endpoint type, GID and QoS, and the DDS names.
 void run_info(const CommonOptions& o, bool verbose) {
   runtime::dds::Participant participant(o.domain, environment_partition());
   const TopicInfo info = find_topic(participant, o);
@@ -243,9 +256,27 @@ void run_info(const CommonOptions& o, bool verbose) {
   if (!verbose) return;
   std::printf("DDS topic: %s\nDDS type: %s\n", dds_topic_of(o.topic).c_str(),
               info.type_name.c_str());
+  // Which node each endpoint belongs to: ros_discovery_info (transient local: at once).
+  std::map<runtime::Gid, std::pair<std::string, std::string>> node_of;  // namespace, name
+  for (const auto& p : runtime::read_ros_discovery(participant, std::chrono::milliseconds(1000))) {
+    for (const auto& n : p.nodes) {
+      for (const auto* gids : {&n.readers, &n.writers}) {
+        for (const auto& g : *gids) node_of[g] = {n.node_namespace, n.node_name};
+      }
+    }
+  }
   for (const auto* side : {&info.publishers, &info.subscribers}) {
-    std::printf("%s:\n", side == &info.publishers ? "Publishers" : "Subscriptions");
-    for (const auto& e : *side) std::printf("  QoS: %s\n", e.qos.c_str());
+    const bool publishers = side == &info.publishers;
+    std::printf("%s:\n", publishers ? "Publishers" : "Subscriptions");
+    for (const auto& e : *side) {
+      const auto node = node_of.find(e.gid);
+      std::printf("  Node name: %s\n  Node namespace: %s\n  Endpoint type: %s\n  GID: %s\n",
+                  node != node_of.end() ? node->second.second.c_str() : "_NODE_NAME_UNKNOWN_",
+                  node != node_of.end() ? node->second.first.c_str()
+                                        : "_NODE_NAMESPACE_UNKNOWN_",
+                  publishers ? "PUBLISHER" : "SUBSCRIPTION", gid_text(e.gid).c_str());
+      std::printf("  QoS: %s\n", e.qos.c_str());
+    }
   }
 }
 
