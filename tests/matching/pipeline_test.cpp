@@ -1,5 +1,7 @@
 // MatchingPipeline: a target cut by the image border gives no pose (the visible part would be
 // fitted anywhere) and the tracker starts over; the whole target is matched.
+#include <stdexcept>
+
 #include <gtest/gtest.h>
 
 #include "avs/matching/model_cloud.hpp"
@@ -51,6 +53,55 @@ TEST(MatchingPipeline, TargetCutByTheImageBorderGivesNoPose) {
                              config);
   out = unguarded.process(cut.view(), 0.0);
   EXPECT_FALSE(out.truncated);
+}
+
+TEST(MatchingPipeline, RetuneChangesTheLiveSettingsAndKeepsTheTrackingState) {
+  // The matching component's live parameters (issue 18 section 1): the depth window and the
+  // per-frame checks change between two frames; the tracker keeps its state.
+  const geometry::Mesh cube = make_cube_mesh(0.1F);
+  PipelineConfig config;
+  config.camera = test::paper_camera();
+  MatchingPipeline pipeline(make_model_cloud(cube, ModelCloudConfig{.target_points = 488}), config);
+  const DepthImage whole = render_depth(cube, cube_at(0.0F), config.camera);
+  PipelineOutput out = pipeline.process(whole.view(), 0.0);
+  ASSERT_TRUE(out.has_pose);
+  out = pipeline.process(whole.view(), 0.002);
+  ASSERT_TRUE(out.has_pose);
+  EXPECT_FALSE(out.track.initialised_this_frame) << "tracking, not re-initialising";
+
+  // A window that ends before the cube (about 0.8 m away): no target pixels, no valid match.
+  PipelineConfig narrow = config;
+  narrow.depth_max_m = 0.5F;
+  pipeline.retune(narrow);
+  out = pipeline.process(whole.view(), 0.004);
+  EXPECT_EQ(out.valid_pixels, 0u);
+  EXPECT_FALSE(out.track.pose_valid);  // a failed frame (the tracker coasts until the loss)
+
+  // Back, with an inlier ratio no frame can reach: frames fail until the target is lost
+  // after failures_before_loss of them (3), not before.
+  PipelineConfig strict = config;
+  strict.tracker.min_inlier_ratio = 1.01F;
+  strict.tracker.failures_before_loss = 3;
+  pipeline.retune(strict);
+  EXPECT_EQ(pipeline.config().depth_max_m, config.depth_max_m);
+  out = pipeline.process(whole.view(), 0.006);
+  EXPECT_GT(out.valid_pixels, 0u);
+  EXPECT_FALSE(out.track.pose_valid);
+
+  // Refused, nothing changed: an empty window.
+  PipelineConfig empty = config;
+  empty.depth_min_m = 1.0F;
+  empty.depth_max_m = 0.9F;
+  EXPECT_THROW(pipeline.retune(empty), std::invalid_argument);
+  EXPECT_EQ(pipeline.config().depth_min_m, config.depth_min_m);
+  EXPECT_EQ(pipeline.config().tracker.min_inlier_ratio, 1.01F);
+
+  // The defaults again: tracked poses.
+  pipeline.reset();
+  pipeline.retune(config);
+  out = pipeline.process(whole.view(), 0.008);
+  EXPECT_TRUE(out.has_pose);
+  EXPECT_LT((out.T_camera_model.translation() - cube_at(0.0F).translation()).norm(), 0.005F);
 }
 
 }  // namespace

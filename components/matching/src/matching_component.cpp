@@ -134,26 +134,36 @@ class MatchingComponent final : public runtime::Component {
                   "are not used")
             .real("max_rmse_m", AVS_FIELD(pipeline.tracker.max_rmse_m), 0.0, 1.0, "m",
                   "a frame fails above this ICP RMSE (0 = model's mean spacing)")
+            .live()
             .real("min_inlier_ratio", AVS_FIELD(pipeline.tracker.min_inlier_ratio), 0.0, 1.0, "",
                   "a frame fails below this inlier ratio")
+            .live()
             .integer("failures_before_loss", AVS_FIELD(pipeline.tracker.failures_before_loss), 1,
                      100000, "", "consecutive failed frames that declare the target lost")
+            .live()
             .integer("min_scene_points", AVS_FIELD(pipeline.tracker.min_scene_points), 3, 100000,
                      "", "fewer S-PCD points: no match (counts as a failure)")
+            .live()
             .integer("max_border_pixels", AVS_FIELD(pipeline.max_border_pixels), -1, 100000, "px",
                      "target-window pixels on the image border above which the target is cut "
                      "off: no pose, re-initialise when whole (-1: off)")
+            .live()
             .boolean("constant_velocity", AVS_FIELD(pipeline.tracker.constant_velocity),
                      "ICP starts from the constant-velocity prediction")
+            .live()
             .real("lag_compensation_s", AVS_FIELD(pipeline.lag_compensation_s), 0.0, 0.1, "s",
                   "extrapolate the published pose by this at the tracked velocity "
                   "(docs/matching.md: measured lag and why the default)")
+            .live()
             .real("velocity_window_s", AVS_FIELD(pipeline.velocity_window_s), 1e-4, 1.0, "s",
                   "span of tracked poses the velocity is estimated over")
+            .live()
             .real("depth_min_m", AVS_FIELD(pipeline.depth_min_m), 0.0, 100.0, "m",
                   "target mask: nearest depth")
+            .live()
             .real("depth_max_m", AVS_FIELD(pipeline.depth_max_m), 0.0, 100.0, "m",
                   "target mask: farthest depth")
+            .live()
             .vector("head_p_world_pan_m", AVS_FIELD(head.p_world_pan_m), "m",
                     "pan axis foot point in the world (geometry::HeadConfig)")
             .vector("head_p_pan_tilt_m", AVS_FIELD(head.p_pan_tilt_m), "m",
@@ -223,6 +233,14 @@ class MatchingComponent final : public runtime::Component {
 
   std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
     return {rejected_.diagnostic()};
+  }
+
+  /// The live parameters (depth window, the tracker's per-frame checks, lag compensation)
+  /// take effect from the next depth image; the tracking state is kept. An empty window is
+  /// refused (the parameter service answers with the reason, nothing changes).
+  void on_parameters_changed(const runtime::ParameterValues& values,
+                             const std::vector<std::string>& /*changed*/) override {
+    pipeline_->retune(params().make(values).pipeline);
   }
 
   void on_deactivate() override {

@@ -57,6 +57,29 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
   }
 }
 
+void MatchingPipeline::retune(const PipelineConfig& config) {
+  if (!(config.depth_min_m < config.depth_max_m)) {
+    throw std::invalid_argument("depth_min_m (" + std::to_string(config.depth_min_m) +
+                                ") must be below depth_max_m (" +
+                                std::to_string(config.depth_max_m) + ")");
+  }
+  if (config.lag_compensation_s < 0.0 || config.velocity_window_s <= 0.0) {
+    throw std::invalid_argument("lag_compensation_s must be >= 0 and velocity_window_s > 0");
+  }
+  config_.depth_min_m = config.depth_min_m;
+  config_.depth_max_m = config.depth_max_m;
+  builder_.set_depth_window(config.depth_min_m, config.depth_max_m);
+  config_.lag_compensation_s = config.lag_compensation_s;
+  config_.velocity_window_s = config.velocity_window_s;
+  config_.max_border_pixels = config.max_border_pixels;
+  config_.tracker.max_rmse_m = config.tracker.max_rmse_m;
+  config_.tracker.min_inlier_ratio = config.tracker.min_inlier_ratio;
+  config_.tracker.failures_before_loss = config.tracker.failures_before_loss;
+  config_.tracker.min_scene_points = config.tracker.min_scene_points;
+  config_.tracker.constant_velocity = config.tracker.constant_velocity;
+  tracker_.retune(config.tracker);
+}
+
 std::size_t MatchingPipeline::border_pixels(const DepthView& depth) const {
   const int w = depth.width_px;
   const int h = depth.height_px;

@@ -47,11 +47,18 @@ Tracker::Tracker(const ModelCloud& model, TrackerConfig config)
         std::to_string(model.dense_points_m.size()) + " points, " +
         std::to_string(model.dense_normals.size()) + " normals)");
   }
-  if (!(config_.max_rmse_m > 0.0F)) {
-    config_.max_rmse_m = config_.dense_icp_model && model.mean_spacing_m > 0.0F
-                             ? model.mean_spacing_m
-                             : icp_.model_spacing_m();
-  }
+  default_max_rmse_m_ = config_.dense_icp_model && model.mean_spacing_m > 0.0F
+                           ? model.mean_spacing_m
+                           : icp_.model_spacing_m();
+  if (!(config_.max_rmse_m > 0.0F)) config_.max_rmse_m = default_max_rmse_m_;
+}
+
+void Tracker::retune(const TrackerConfig& config) {
+  config_.max_rmse_m = config.max_rmse_m > 0.0F ? config.max_rmse_m : default_max_rmse_m_;
+  config_.min_inlier_ratio = config.min_inlier_ratio;
+  config_.failures_before_loss = config.failures_before_loss;
+  config_.min_scene_points = config.min_scene_points;
+  config_.constant_velocity = config.constant_velocity;
 }
 
 void Tracker::reset() {

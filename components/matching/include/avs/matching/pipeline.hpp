@@ -71,6 +71,11 @@ class MatchingPipeline {
   PipelineOutput process(const DepthView& depth, double stamp_s, double data_age_s);
 
   void reset() { tracker_.reset(); }
+  /// The live settings of `config`, the tracking state kept (the matching component's live
+  /// parameters): the depth window, lag compensation, velocity window, border limit and the
+  /// tracker's per-frame checks (Tracker::retune). Throws std::invalid_argument, changing
+  /// nothing, when the window is empty or the lag settings are out of range.
+  void retune(const PipelineConfig& config);
   /// The camera model in force (from /depth/camera_info); the tracker's state is kept.
   void set_camera(const geometry::CameraModel& camera) { config_.camera = camera; }
   [[nodiscard]] const Points& scene_points() const { return *scene_; }

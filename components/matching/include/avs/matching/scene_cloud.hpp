@@ -38,6 +38,11 @@ class SceneCloudBuilder {
   /// Points after stride sampling, before voxel down-sampling.
   [[nodiscard]] std::size_t sampled_points() const { return sampled_.size(); }
   [[nodiscard]] const SceneCloudConfig& config() const { return config_; }
+  /// The depth window (live parameters); the scratch buffers are kept.
+  void set_depth_window(float min_depth_m, float max_depth_m) {
+    config_.min_depth_m = min_depth_m;
+    config_.max_depth_m = max_depth_m;
+  }
 
  private:
   SceneCloudConfig config_;

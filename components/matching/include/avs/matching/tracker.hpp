@@ -54,6 +54,12 @@ class Tracker {
   /// Forget the target: the next frame runs the initial alignment.
   void reset();
 
+  /// The per-frame checks from `config` (max_rmse_m, 0 = the model's spacing as at
+  /// construction; min_inlier_ratio, failures_before_loss, min_scene_points,
+  /// constant_velocity), the state kept: what the matching component changes while it runs.
+  /// The ICP and initial-alignment settings and the ICP model need a new Tracker.
+  void retune(const TrackerConfig& config);
+
   [[nodiscard]] TrackingState state() const { return state_; }
   [[nodiscard]] const InitialAlignmentResult& last_initial_alignment() const {
     return last_initial_;
@@ -63,6 +69,7 @@ class Tracker {
   [[nodiscard]] Eigen::Isometry3f predict(double stamp_s) const;
 
   TrackerConfig config_;
+  float default_max_rmse_m_ = 0.0F;  ///< what max_rmse_m 0 stands for (the model's spacing)
   Icp icp_;
   InitialAligner initial_;
   TrackingState state_ = TrackingState::waiting;
