@@ -286,7 +286,9 @@ TEST(CameraLoopback, PosesOverGigEVisionEqualTheDirectSimulatorPath) {
   EXPECT_EQ(checker->wrong_labels, 0);
   EXPECT_EQ(checker->unmatched_maps, 0);
   EXPECT_EQ(checker->equal_maps, checker->depth_maps);
-  EXPECT_GT(checker->forwarded_maps, 50);
+  // Counts only need to show that both paths were matched: how many maps and poses come in 6 s
+  // depends on the machine (about 500 here, 25 under ASan in CI).
+  EXPECT_GT(checker->forwarded_maps, 10);
   // Poses of the same maps (the run may stop between the two matchings' turns at the end).
   std::int64_t common = 0;
   double position_m = 0, orientation = 0;
@@ -310,7 +312,7 @@ TEST(CameraLoopback, PosesOverGigEVisionEqualTheDirectSimulatorPath) {
               static_cast<long long>(checker->forwarded_maps), checker->checked_poses.size(),
               checker->direct_poses.size(), static_cast<long long>(common), position_m,
               orientation);
-  EXPECT_GT(common, 40);
+  EXPECT_GE(common, 5);
   EXPECT_GE(static_cast<std::int64_t>(checker->direct_poses.size()), common);
   EXPECT_LE(position_m, 1e-6);
   EXPECT_LE(orientation, 1e-6);  // about 2e-6 rad
