@@ -379,7 +379,9 @@ class ServoDrive final : public runtime::Component {
                        (names.empty() ? " joints (no names: one per joint, in order)" : " names"));
       return;
     }
-    std::vector<double> command(names_.size(), 0.0);
+    // Kept between commands: a 1 kHz callback allocates nothing once it has run.
+    std::vector<double>& command = command_scratch_;
+    command.assign(names_.size(), 0.0);
     if (names.empty()) {
       for (std::size_t i = 0; i < std::min(command.size(), torques.size()); ++i) {
         command[i] = torques[i];
@@ -609,6 +611,7 @@ class ServoDrive final : public runtime::Component {
   std::vector<std::string> names_;
   std::unique_ptr<DriveClient> client_;
   CycleResult cycle_result_;  ///< run_cycle()'s, reused every cycle
+  std::vector<double> command_scratch_;  ///< on_command()'s, reused every command
   std::int64_t missed_since_log_ = 0;
   double last_missed_log_s_ = -1e300;
   runtime::Duration period_{1'000'000};
