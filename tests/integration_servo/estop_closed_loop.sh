@@ -10,12 +10,8 @@ set -euo pipefail
 avs=$1; src=$2
 . "$src/tests/integration_servo/lib.sh"
 out=$(mktemp -d)
-trap '[ -n "$launch_pid" ] && kill -INT "$launch_pid" 2>/dev/null; rm -rf "$out"' EXIT
-mkdir -p "$out/drive"
-live_log="$out/stderr.txt"  # wait_for (lib.sh) reads it
-"$avs" launch "$src/launch_config/closed_loop.yaml" port:=$port run_dir:="$out/run" \
-  drive_report_dir:="$out/drive" duration_s:=0 2>"$live_log" &
-launch_pid=$!
+start_lockstep "$out/drive" "$src/launch_config/closed_loop.yaml" run_dir:="$out/run" \
+  drive_report_dir:="$out/drive" duration_s:=0
 pub() {
   "$avs" topic pub /head/estop std_msgs/msg/Bool "$1" --once --wait 60 >"$out/pub.txt" 2>&1 ||
     { cat "$out/pub.txt" "$live_log" >&2; fail "avs topic pub $1"; }
@@ -33,9 +29,7 @@ sleep 2
 pub '{data: false}'
 wait_for "e-stop released"
 sleep 3  # cycles after the release (at least 10 ms of sim time even under a sanitizer)
-kill -INT "$launch_pid"
-wait "$launch_pid" || { cat "$live_log" >&2; fail "the closed loop failed"; }
-launch_pid=
+stop_lockstep
 csv="$out/drive/drive.csv"
 [ -s "$csv" ] || { cat "$live_log" >&2; fail "no drive report"; }
 pan=$(column "$csv" pan_cmd_nm); tilt=$(column "$csv" tilt_cmd_nm)

@@ -30,6 +30,23 @@ start_live() {
   launch_pid=$!
 }
 stop_live() { kill -TERM "$launch_pid"; wait "$launch_pid" || true; launch_pid=; }
+# start_lockstep DIR GRAPH [name:=value ...]: launches GRAPH in the background as the file says
+# (lockstep), our Modbus port given, its log in DIR/stderr.txt (launch_pid, live_log for
+# wait_for); the EXIT trap stops it and removes the caller's temporary folder `out`.
+start_lockstep() {
+  local dir=$1 file=$2; shift 2
+  trap '[ -n "$launch_pid" ] && kill -INT "$launch_pid" 2>/dev/null; rm -rf "$out"' EXIT
+  mkdir -p "$dir"
+  live_log="$dir/stderr.txt"
+  "$avs" launch "$file" port:=$port "$@" 2>"$live_log" &
+  launch_pid=$!
+}
+# stop_lockstep: Ctrl-C to the graph of start_lockstep, which must end cleanly.
+stop_lockstep() {
+  kill -INT "$launch_pid"
+  wait "$launch_pid" || { cat "$live_log" >&2; fail "the graph failed"; }
+  launch_pid=
+}
 # wait_for PATTERN: until the live launch's log has it (at most 60 s).
 wait_for() {
   for _ in $(seq 600); do

@@ -428,6 +428,56 @@ TEST(DriveClientConfigCheck, RefusesAResponseTimeoutLongerThanThePeriod) {
 // Issue 20 1.4: soft limits with only a brake zone let a held 1 N m take pan to 4.18 rad
 // (limit 3.0), a saturated command to 7.0 rad (tilt -3.84 against -1.4). At 1 kHz in
 // lockstep, with the plant's truth checked every cycle.
+/// The live settings of a running client (issue 18: servo_drive's live parameters).
+DriveLiveSettings live_settings_of(const DriveClientConfig& c) {
+  DriveLiveSettings live;
+  live.command_freshness = c.command_freshness;
+  live.estop_action = c.estop_action;
+  live.auto_fault_reset = c.auto_fault_reset;
+  for (const DriveAxisConfig& axis : c.axes) live.safety.push_back(axis.safety);
+  return live;
+}
+
+TEST_F(DriveClientTest, RetunedCommandTimeoutTakesEffectFromTheNextCycle) {
+  const DriveClientConfig config = client_config();
+  start(config);
+  DriveLiveSettings longer = live_settings_of(config);
+  longer.command_freshness.timeout_s = 10 * period_s;
+  client_->retune(longer);
+  command(1.0, 0.1);
+  for (int i = 0; i < 6; ++i) cycle();  // 6 periods: stale under the old 3-period limit
+  EXPECT_GT(drive_command(), 0.5) << "the 10-period limit keeps the command";
+  for (int i = 0; i < 5; ++i) cycle();  // 11 periods
+  EXPECT_EQ(drive_command(), 0.0);
+  EXPECT_EQ(client_->config().command_freshness.timeout_s, 10 * period_s);
+}
+
+TEST_F(DriveClientTest, RetunedSoftLimitBrakesTheAxisAndABadOneChangesNothing) {
+  const DriveClientConfig config = client_config();
+  start(config);
+  DriveLiveSettings bad = live_settings_of(config);
+  bad.safety[0].soft_lower_rad = 1.0;
+  bad.safety[0].soft_upper_rad = 0.5;
+  EXPECT_THROW(client_->retune(bad), ConfigError);
+  bad.safety.pop_back();
+  EXPECT_THROW(client_->retune(bad), ConfigError);
+  // Pan at rest near 0: an upper limit at 0 makes any positive torque brake (the axis is at
+  // the limit), where before the same command was applied.
+  command(0.5, 0.0);
+  EXPECT_GT(cycle().axes[0].commanded_torque_nm, 0.4);
+  DriveLiveSettings at_zero = live_settings_of(config);
+  at_zero.safety[0].soft_lower_rad = -3.0;
+  at_zero.safety[0].soft_upper_rad = 0.0;
+  client_->retune(at_zero);
+  command(0.5, 0.0);
+  const CycleResult r = cycle();
+  EXPECT_LE(r.axes[0].commanded_torque_nm, 0.0);
+  EXPECT_TRUE(r.axes[0].safety_reasons &
+              (safety_soft_limit_block | safety_soft_limit_brake | safety_soft_limit_envelope))
+      << r.axes[0].safety_reasons;
+  EXPECT_GT(r.axes[1].commanded_torque_nm, -1e-9);  // tilt unchanged: no limit near
+}
+
 class SoftLimitEnvelopeTest : public ::testing::Test {
  protected:
   static constexpr double envelope_period_s = 0.001;

@@ -339,8 +339,7 @@ bool DriveClient::set_command(const std::vector<double>& torque_nm, double stamp
   }
   // A stamp from the future would stay "fresh" until our clock caught up with it (issue 20
   // 1.1): refuse it; the previous command keeps ageing as before.
-  if (is_future_stamped(config_.command_freshness, stamp_s, arrival_s) ||
-      !std::isfinite(stamp_s)) {
+  if (is_future_stamped(config_.command_freshness, stamp_s, arrival_s) || !std::isfinite(stamp_s)) {
     ++command_stats_.future_stamped;
     command_stats_.last_future_ahead_s = stamp_s - arrival_s;
     return false;
@@ -352,6 +351,22 @@ bool DriveClient::set_command(const std::vector<double>& torque_nm, double stamp
   command_arrival_s_ = arrival_s;
   ++command_stats_.accepted;
   return true;
+}
+
+void DriveClient::retune(const DriveLiveSettings& live) {
+  if (live.safety.size() != config_.axes.size()) {
+    throw ConfigError("servo_drive: " + std::to_string(live.safety.size()) +
+                      " axes of safety settings for " + std::to_string(config_.axes.size()) +
+                      " axes");
+  }
+  for (std::size_t i = 0; i < live.safety.size(); ++i) {
+    if (!(live.safety[i].soft_lower_rad < live.safety[i].soft_upper_rad)) {
+      throw ConfigError("servo_drive: axis " + config_.axes[i].name +
+                        ": soft_lower_rad must be below soft_upper_rad");
+    }
+  }
+  std::lock_guard lock(command_mutex_);
+  retuned_ = live;
 }
 
 CommandStatistics DriveClient::command_statistics() const {
@@ -697,6 +712,22 @@ void DriveClient::cycle(double now_s, CycleResult& result) {
   bool reset = false;
   {
     std::lock_guard lock(command_mutex_);
+    if (retuned_) {
+      // Under the command mutex: set_command() reads command_freshness under it too.
+      config_.command_freshness = retuned_->command_freshness;
+      config_.estop_action = retuned_->estop_action;
+      config_.auto_fault_reset = retuned_->auto_fault_reset;
+      for (std::size_t i = 0; i < config_.axes.size(); ++i) {
+        AxisSafetyConfig& axis = config_.axes[i].safety;
+        const AxisSafetyConfig& next = retuned_->safety[i];
+        axis.soft_lower_rad = next.soft_lower_rad;
+        axis.soft_upper_rad = next.soft_upper_rad;
+        axis.brake_zone_rad = next.brake_zone_rad;
+        axis.brake_gain_nm_s_per_rad = next.brake_gain_nm_s_per_rad;
+        axis.envelope_brake_fraction = next.envelope_brake_fraction;
+      }
+      retuned_.reset();
+    }
     std::copy(command_nm_.begin(), command_nm_.end(), command.begin());
     stamp = command_stamp_s_;
     arrival = command_arrival_s_;

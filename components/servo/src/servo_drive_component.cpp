@@ -108,13 +108,17 @@ class ServoDrive final : public runtime::Component {
              per_axis("motor_max_torque_nm", &AxisSafetyConfig::motor_max_torque_nm, "N m",
                       "motor peak torque per axis (Table 3)"),
              per_axis("soft_lower_rad", &AxisSafetyConfig::soft_lower_rad, "rad",
-                      "soft lower position limit per axis"),
+                      "soft lower position limit per axis")
+                 .live(),
              per_axis("soft_upper_rad", &AxisSafetyConfig::soft_upper_rad, "rad",
-                      "soft upper position limit per axis"),
+                      "soft upper position limit per axis")
+                 .live(),
              ParamSpec::real("brake_zone_rad", any_axis.brake_zone_rad, 0.0, 10.0, "rad",
-                             "braking zone inside each soft limit"),
+                             "braking zone inside each soft limit")
+                 .live(),
              per_axis("brake_gain_nm_s_per_rad", &AxisSafetyConfig::brake_gain_nm_s_per_rad,
-                      "N m s/rad", "braking torque per output rad/s toward a nearby limit"),
+                      "N m s/rad", "braking torque per output rad/s toward a nearby limit")
+                 .live(),
              per_axis("output_inertia_kg_m2", &AxisSafetyConfig::output_inertia_kg_m2, "kg m2",
                       "output-side inertia J_eq per axis, for the soft-limit velocity envelope "
                       "(0 = no envelope)"),
@@ -125,13 +129,15 @@ class ServoDrive final : public runtime::Component {
              ParamSpec::real("envelope_brake_fraction", any_axis.envelope_brake_fraction, 0.0, 1.0,
                              "",
                              "share of the full braking deceleration the velocity envelope "
-                             "plans with (the rest is margin); 0 = no envelope"),
+                             "plans with (the rest is margin); 0 = no envelope")
+                 .live(),
              ParamSpec::boolean("own_thread", false,
                                 "cycle on a thread of its own (wall time only); false = "
                                 "container timer (required in sim time)"),
              ParamSpec::integer("rt_priority", 0, 0, 99, "",
                                 "own_thread: SCHED_FIFO priority (0 = normal scheduling)"),
-             ParamSpec::real("status_rate_hz", 10.0, 0.1, 1000.0, "Hz", "/head/drive_status rate"),
+             ParamSpec::real("status_rate_hz", 10.0, 0.1, 1000.0, "Hz", "/head/drive_status rate")
+                 .live(),
              ParamSpec::string("report_dir", "",
                                "tests: write <name>.csv (every cycle) and <name>.yaml (summary) "
                                "here on deactivate; empty = none")}),
@@ -179,10 +185,12 @@ class ServoDrive final : public runtime::Component {
                      "one 0x17 write+read per axis, else 0x10 + 0x03")
             .real("command_timeout_s", AVS_FIELD(command_freshness.timeout_s), 0.0001, 10.0, "s",
                   "torque commands whose stamp or arrival is older than this -> zero torque")
+            .live()
             .real("command_future_tolerance_s", AVS_FIELD(command_freshness.future_tolerance_s),
                   0.0, 1.0, "s",
                   "torque commands stamped later than their arrival by more than this are "
                   "rejected and counted (sender clock ahead)")
+            .live()
             .integer("fault_clear_stable_cycles", AVS_FIELD(fault_clear_stable_cycles), 1, 100000,
                      "",
                      "a drive fault latches zero torque until a reset request and this many "
@@ -192,8 +200,10 @@ class ServoDrive final : public runtime::Component {
                         {"disable_operation", EstopAction::disable_operation},
                         {"quick_stop", EstopAction::quick_stop}},
                     "what an e-stop does")
+            .live()
             .boolean("auto_fault_reset", AVS_FIELD(auto_fault_reset),
                      "reset drive faults automatically once their cause is gone")
+            .live()
             .real("reconnect_backoff_initial_s", AVS_FIELD(reconnect_backoff_initial_s), 0.0001,
                   60.0, "s", "first reconnect delay after a link fault (doubles)")
             .real("reconnect_backoff_max_s", AVS_FIELD(reconnect_backoff_max_s), 0.0001, 600.0, "s",
@@ -223,10 +233,8 @@ class ServoDrive final : public runtime::Component {
           "container timer (own_thread: false) to stay deterministic");
     }
     DriveClientConfig config = make_config(ctx);
-    const double status_rate = ctx.param<double>("status_rate_hz");
-    cycles_per_status_ =
-        std::max<std::int64_t>(1, std::llround(config.cycle_rate_hz / status_rate));
     period_ = runtime::Duration(std::llround(1e9 / config.cycle_rate_hz));
+    cycles_per_status_ = status_cycles(ctx.parameters());
     for (const DriveAxisConfig& axis : config.axes) names_.push_back(axis.name);
     client_ = std::make_unique<DriveClient>(std::move(config));  // validates: one-line ConfigError
     try {
@@ -278,21 +286,47 @@ class ServoDrive final : public runtime::Component {
   void on_shutdown() override { client_->disconnect(); }
 
  private:
+  static std::vector<std::string> axis_names(const runtime::ParameterValues& values) {
+    return msg::parse_name_list(values.get<std::string>("axis_names"), 0, "axis_names");
+  }
+
+  /// Each axis's safety rules from the per-axis parameters (one place for the start-up
+  /// configuration and the live changes).
+  static std::vector<AxisSafetyConfig> safety_of(const runtime::ParameterValues& values,
+                                                 std::size_t axes) {
+    const auto list = [&](const char* name) { return values.get<std::vector<double>>(name); };
+    const auto max_torque = list("max_torque_nm");
+    const auto motor_max = list("motor_max_torque_nm");
+    const auto lower = list("soft_lower_rad");
+    const auto upper = list("soft_upper_rad");
+    const auto brake_gain = list("brake_gain_nm_s_per_rad");
+    const auto inertia = list("output_inertia_kg_m2");
+    const auto gear_ratio = list("gear_ratio");
+    const auto gear_efficiency = list("gear_efficiency");
+    std::vector<AxisSafetyConfig> out(axes);
+    for (std::size_t i = 0; i < axes; ++i) {
+      AxisSafetyConfig& a = out[i];
+      a.configured_max_torque_nm = element(max_torque, i, "max_torque_nm");
+      a.motor_max_torque_nm = element(motor_max, i, "motor_max_torque_nm");
+      a.soft_lower_rad = element(lower, i, "soft_lower_rad");
+      a.soft_upper_rad = element(upper, i, "soft_upper_rad");
+      a.brake_zone_rad = values.get<double>("brake_zone_rad");
+      a.brake_gain_nm_s_per_rad = element(brake_gain, i, "brake_gain_nm_s_per_rad");
+      a.output_inertia_kg_m2 = element(inertia, i, "output_inertia_kg_m2");
+      a.gear_ratio = element(gear_ratio, i, "gear_ratio");
+      a.gear_efficiency = element(gear_efficiency, i, "gear_efficiency");
+      a.envelope_brake_fraction = values.get<double>("envelope_brake_fraction");
+    }
+    return out;
+  }
+
   DriveClientConfig make_config(ComponentContext& ctx) {
     DriveClientConfig c = params().make(ctx.parameters());
     c.tcp.port = ctx.param<int>("port");
 
-    const std::vector<std::string> names =
-        msg::parse_name_list(ctx.param<std::string>("axis_names"), 0, "axis_names");
+    const std::vector<std::string> names = axis_names(ctx.parameters());
     const auto unit_ids = ctx.param<std::vector<double>>("unit_ids");
-    const auto max_torque = ctx.param<std::vector<double>>("max_torque_nm");
-    const auto motor_max = ctx.param<std::vector<double>>("motor_max_torque_nm");
-    const auto lower = ctx.param<std::vector<double>>("soft_lower_rad");
-    const auto upper = ctx.param<std::vector<double>>("soft_upper_rad");
-    const auto brake_gain = ctx.param<std::vector<double>>("brake_gain_nm_s_per_rad");
-    const auto inertia = ctx.param<std::vector<double>>("output_inertia_kg_m2");
-    const auto gear_ratio = ctx.param<std::vector<double>>("gear_ratio");
-    const auto gear_efficiency = ctx.param<std::vector<double>>("gear_efficiency");
+    const std::vector<AxisSafetyConfig> safety = safety_of(ctx.parameters(), names.size());
     const std::string map_file = ctx.param<std::string>("register_map");
     std::vector<RegisterMap> maps;
     if (!map_file.empty()) {
@@ -316,16 +350,7 @@ class ServoDrive final : public runtime::Component {
       axis.name = names[i];
       axis.unit_id = static_cast<int>(element(unit_ids, i, "unit_ids"));
       axis.registers = maps[i];
-      axis.safety.configured_max_torque_nm = element(max_torque, i, "max_torque_nm");
-      axis.safety.motor_max_torque_nm = element(motor_max, i, "motor_max_torque_nm");
-      axis.safety.soft_lower_rad = element(lower, i, "soft_lower_rad");
-      axis.safety.soft_upper_rad = element(upper, i, "soft_upper_rad");
-      axis.safety.brake_zone_rad = ctx.param<double>("brake_zone_rad");
-      axis.safety.brake_gain_nm_s_per_rad = element(brake_gain, i, "brake_gain_nm_s_per_rad");
-      axis.safety.output_inertia_kg_m2 = element(inertia, i, "output_inertia_kg_m2");
-      axis.safety.gear_ratio = element(gear_ratio, i, "gear_ratio");
-      axis.safety.gear_efficiency = element(gear_efficiency, i, "gear_efficiency");
-      axis.safety.envelope_brake_fraction = ctx.param<double>("envelope_brake_fraction");
+      axis.safety = safety[i];
       if (!(axis.safety.soft_lower_rad < axis.safety.soft_upper_rad)) {
         throw ConfigError("servo_drive: axis " + axis.name +
                           ": soft_lower_rad must be below "
@@ -413,7 +438,7 @@ class ServoDrive final : public runtime::Component {
     future_stamped_logged_ = s.future_stamped;
     log().warn("torque command rejected: stamped ", s.last_future_ahead_s,
                " s after its arrival (tolerance ",
-               client_->config().command_freshness.future_tolerance_s,
+               context().parameters().get<double>("command_future_tolerance_s"),
                " s; sender clock ahead?); ", s.future_stamped, " rejected so far");
   }
 
@@ -433,6 +458,27 @@ class ServoDrive final : public runtime::Component {
             {"bad_replies", std::to_string(l.bad_replies)},
             {"errors", std::to_string(l.errors)},
             {"reconnects", std::to_string(l.reconnects)}};
+  }
+
+  /// The live parameters (command rules, e-stop action, automatic fault reset, soft-limit
+  /// rules, status rate) take effect from the next drive cycle (DriveClient::retune); a refusal
+  /// (soft_lower_rad not below soft_upper_rad) changes nothing.
+  void on_parameters_changed(const runtime::ParameterValues& values,
+                             const std::vector<std::string>& /*changed*/) override {
+    const DriveClientConfig c = params().make(values);
+    DriveLiveSettings live;
+    live.command_freshness = c.command_freshness;
+    live.estop_action = c.estop_action;
+    live.auto_fault_reset = c.auto_fault_reset;
+    live.safety = safety_of(values, names_.size());
+    client_->retune(live);
+    cycles_per_status_ = status_cycles(values);
+  }
+
+  std::int64_t status_cycles(const runtime::ParameterValues& values) const {
+    const double cycle_rate_hz = 1e9 / static_cast<double>(period_.count());
+    return std::max<std::int64_t>(
+        1, std::llround(cycle_rate_hz / values.get<double>("status_rate_hz")));
   }
 
   void on_estop(bool active) {
@@ -595,11 +641,11 @@ class ServoDrive final : public runtime::Component {
          << "\ntimeouts: " << s.timeouts << "\nmissed_cycles: " << s.missed_cycles
          << "\nlate_replies: " << s.late_replies << "\nexceptions: " << s.exceptions
          << "\nstale_replies: " << s.stale_replies << "\nbad_replies: " << s.bad_replies
-         << "\nerrors: " << s.errors
-         << "\nreconnects: " << s.reconnects << "\nconnect_failures: " << s.connect_failures
+         << "\nerrors: " << s.errors << "\nreconnects: " << s.reconnects
+         << "\nconnect_failures: " << s.connect_failures
          << "\ncommands_future_stamped: " << client_->command_statistics().future_stamped
-         << "\nrejected_commands: " << rejected_.count()
-         << "\nfirst_fault_message: \"" << first_fault_message_ << "\"\n";
+         << "\nrejected_commands: " << rejected_.count() << "\nfirst_fault_message: \""
+         << first_fault_message_ << "\"\n";
     if (!csv || !yaml) log().error("cannot write the report to ", base, ".{csv,yaml}");
   }
 
@@ -610,12 +656,12 @@ class ServoDrive final : public runtime::Component {
   std::string report_dir_;
   std::vector<std::string> names_;
   std::unique_ptr<DriveClient> client_;
-  CycleResult cycle_result_;  ///< run_cycle()'s, reused every cycle
+  CycleResult cycle_result_;             ///< run_cycle()'s, reused every cycle
   std::vector<double> command_scratch_;  ///< on_command()'s, reused every command
   std::int64_t missed_since_log_ = 0;
   double last_missed_log_s_ = -1e300;
   runtime::Duration period_{1'000'000};
-  std::int64_t cycles_per_status_ = 100;
+  std::atomic<std::int64_t> cycles_per_status_ = 100;  ///< set live, read by the cycle
   runtime::TimerId timer_ = 0;
   std::thread thread_;
   std::atomic<bool> stop_{false};

@@ -25,39 +25,40 @@ class TestTorqueStep final : public runtime::Component {
     keep_last_1.depth = 1;
     runtime::QosProfile estop_qos = keep_last_1;
     estop_qos.durability = runtime::Durability::transient_local;
-    return {
-        .type = "test_torque_step",
-        .description =
-            "tests: publishes /head/torque_command (torque_nm inside "
-            "[step_at_s, step_until_s), else 0) and an e-stop window",
-        .parameters = {ParamSpec::real("rate_hz", 1000.0, 0.1, 100000.0, "Hz", "command rate"),
-                       ParamSpec::string("joint_names", "pan,tilt",
-                                         "comma-separated joint names (at most 2)"),
-                       ParamSpec::real_list("torque_nm", {0.5, 0.0}, "N m",
-                                            "motor torque per joint during the step"),
-                       ParamSpec::real("step_at_s", 0.1, 0.0, std::nullopt, "s",
-                                       "step start (container clock)"),
-                       ParamSpec::real("step_until_s", 0.12, 0.0, std::nullopt, "s", "step end"),
-                       ParamSpec::real("estop_at_s", -1.0, -1.0, std::nullopt, "s",
-                                       "publish e-stop true at this time (-1 = never)"),
-                       ParamSpec::real("estop_release_s", -1.0, -1.0, std::nullopt, "s",
-                                       "publish e-stop false at this time (-1 = never)"),
-                       ParamSpec::real("fault_reset_at_s", -1.0, -1.0, std::nullopt, "s",
-                                       "publish one /head/fault_reset at this time (-1 = never)"),
-                       ParamSpec::real("stamp_offset_s", 0.0, -1e6, 1e6, "s",
-                                       "stamp the commands this much after the clock (a "
-                                       "sender clock ahead, if positive)"),
-                       ParamSpec::real("bad_from_s", -1.0, -1.0, std::nullopt, "s",
-                                       "from this time (-1 = never) until bad_until_s, "
-                                       "malformed commands: a NaN torque, then one torque "
-                                       "for two names, in turn"),
-                       ParamSpec::real("bad_until_s", -1.0, -1.0, std::nullopt, "s",
-                                       "end of the malformed commands")},
-        .publishes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
-                          "torque_command", "/head/torque_command", keep_last_1),
-                      runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
-                      runtime::port<msgs::std_msgs::Empty>("fault_reset", "/head/fault_reset")},
-        .subscribes = {}};
+    return {.type = "test_torque_step",
+            .description =
+                "tests: publishes /head/torque_command (torque_nm inside "
+                "[step_at_s, step_until_s), else 0) and an e-stop window",
+            .parameters =
+                {ParamSpec::real("rate_hz", 1000.0, 0.1, 100000.0, "Hz", "command rate"),
+                 ParamSpec::string("joint_names", "pan,tilt",
+                                   "comma-separated joint names (at most 2)"),
+                 ParamSpec::real_list("torque_nm", {0.5, 0.0}, "N m",
+                                      "motor torque per joint during the step"),
+                 ParamSpec::real("step_at_s", 0.1, 0.0, std::nullopt, "s",
+                                 "step start (container clock)")
+                     .live(),
+                 ParamSpec::real("step_until_s", 0.12, 0.0, std::nullopt, "s", "step end").live(),
+                 ParamSpec::real("estop_at_s", -1.0, -1.0, std::nullopt, "s",
+                                 "publish e-stop true at this time (-1 = never)"),
+                 ParamSpec::real("estop_release_s", -1.0, -1.0, std::nullopt, "s",
+                                 "publish e-stop false at this time (-1 = never)"),
+                 ParamSpec::real("fault_reset_at_s", -1.0, -1.0, std::nullopt, "s",
+                                 "publish one /head/fault_reset at this time (-1 = never)"),
+                 ParamSpec::real("stamp_offset_s", 0.0, -1e6, 1e6, "s",
+                                 "stamp the commands this much after the clock (a "
+                                 "sender clock ahead, if positive)"),
+                 ParamSpec::real("bad_from_s", -1.0, -1.0, std::nullopt, "s",
+                                 "from this time (-1 = never) until bad_until_s, "
+                                 "malformed commands: a NaN torque, then one torque "
+                                 "for two names, in turn"),
+                 ParamSpec::real("bad_until_s", -1.0, -1.0, std::nullopt, "s",
+                                 "end of the malformed commands")},
+            .publishes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
+                              "torque_command", "/head/torque_command", keep_last_1),
+                          runtime::port<msgs::std_msgs::Bool>("estop", "/head/estop", estop_qos),
+                          runtime::port<msgs::std_msgs::Empty>("fault_reset", "/head/fault_reset")},
+            .subscribes = {}};
   }
 
   explicit TestTorqueStep(ComponentContext& ctx)
@@ -90,6 +91,14 @@ class TestTorqueStep final : public runtime::Component {
 
   void on_activate() override {
     context().create_timer(period_, [this] { tick(); });
+  }
+
+  /// A test starts the step when it wants (`avs param set source step_at_s 0`), e.g. after a
+  /// live change of the drive's parameters: the order is then certain in lockstep too.
+  void on_parameters_changed(const runtime::ParameterValues& values,
+                             const std::vector<std::string>& /*changed*/) override {
+    step_at_s_ = values.get<double>("step_at_s");
+    step_until_s_ = values.get<double>("step_until_s");
   }
 
  private:

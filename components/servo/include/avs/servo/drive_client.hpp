@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <mutex>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -80,6 +81,17 @@ struct DriveClientConfig {
   bool auto_fault_reset = false;  ///< reset drive faults without request_fault_reset()
 };
 
+/// What a running drive client may change (servo_drive's live parameters, issue 18): the
+/// command rules, the e-stop action, automatic fault reset and each axis's host-side
+/// soft-limit rules. The rest of AxisSafetyConfig stays as connected: the torque limit is
+/// written to the drive at connect, the motor, inertia and gearing describe the hardware.
+struct DriveLiveSettings {
+  CommandFreshness command_freshness;
+  EstopAction estop_action = EstopAction::disable_operation;
+  bool auto_fault_reset = false;
+  std::vector<AxisSafetyConfig> safety;  ///< one per axis, in the configuration's order
+};
+
 /// Default two-axis configuration for the simulated amplifier (pan unit 1, tilt unit 2).
 DriveClientConfig default_drive_client_config(const std::string& host, int port);
 
@@ -112,14 +124,14 @@ struct LinkStatistics {
   /// for that period, no link fault. A second miss in a row (no valid reply for 2 periods), or
   /// a miss while a late reply is still due, is a link fault.
   std::uint64_t missed_cycles = 0;
-  std::uint64_t late_replies = 0;  ///< replies that came after their timeout: read and dropped
+  std::uint64_t late_replies = 0;   ///< replies that came after their timeout: read and dropped
   std::uint64_t exceptions = 0;     ///< Modbus exception replies
   std::uint64_t stale_replies = 0;  ///< echo counter mismatch
   /// Replies that do not answer the request: wrong unit id, transaction or protocol id,
   /// length, function code or byte count (TCP: checked here; RTU: by libmodbus).
   std::uint64_t bad_replies = 0;
-  std::uint64_t errors = 0;         ///< other I/O errors (reset, broken pipe, bad data)
-  std::uint64_t reconnects = 0;     ///< successful re-connections after a fault
+  std::uint64_t errors = 0;      ///< other I/O errors (reset, broken pipe, bad data)
+  std::uint64_t reconnects = 0;  ///< successful re-connections after a fault
   std::uint64_t connect_failures = 0;
   double rtt_us_p50 = 0;  ///< per axis exchange, over the recent window
   double rtt_us_p99 = 0;
@@ -164,6 +176,11 @@ class DriveClient {
   /// before activation / e-stop release, or later than the arrival plus the tolerance.
   bool set_command(const std::vector<double>& torque_nm, double stamp_s, double arrival_s);
 
+  /// Takes `live` from the start of the next cycle (never within one); thread-safe. Throws
+  /// ConfigError, changing nothing, when it has the wrong number of axes or an axis's soft
+  /// lower limit is not below its upper one.
+  void retune(const DriveLiveSettings& live);
+
   /// One cyclic exchange with every axis at time now_s (same time base as the stamps).
   CycleResult cycle(double now_s);
   /// The same into `result`, reusing its memory: a healthy cycle allocates nothing once
@@ -188,9 +205,9 @@ class DriveClient {
     std::uint16_t read_address = 0;
     std::uint16_t read_count = 0;
     std::uint16_t counter = 0;
-    AxisFeedback last;    ///< last good feedback
-    double last_time_s = 0;  ///< when `last` was read
-    int reset_phase = 0;  ///< fault reset edge: 0 write bit 7 low, 1 write bit 7 high
+    AxisFeedback last;        ///< last good feedback
+    double last_time_s = 0;   ///< when `last` was read
+    int reset_phase = 0;      ///< fault reset edge: 0 write bit 7 low, 1 write bit 7 high
     int missed_in_a_row = 0;  ///< exchanges whose reply missed the timeout, consecutively
     FaultLatch latch;
   };
@@ -242,6 +259,7 @@ class DriveClient {
   bool want_enabled_ = false;
   bool estop_ = false;
   bool fault_reset_requested_ = false;
+  std::optional<DriveLiveSettings> retuned_;  ///< taken by the next cycle
   LinkStatistics stats_;
   CommandStatistics command_stats_;
   SampleWindow rtt_us_;
