@@ -9,16 +9,21 @@
 // `matching` instances take the maps of both paths: the poses must agree within 1e-6.
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -29,6 +34,9 @@
 #include "avs/sim/scene_yaml.hpp"
 #include "avs/sim/simulator.hpp"
 #include "avs/testing/lockstep_graph.hpp"
+#ifdef AVS_PROGRAM
+#include "avs_program.hpp"
+#endif
 #include "sim_gige_camera.hpp"
 
 namespace avs::camera {
@@ -123,8 +131,8 @@ class TestCameraChecker final : public runtime::Component {
   }
 
   /// A 32FC1 map as decode publishes it.
-  static std::shared_ptr<msgs::sensor_msgs::Image> depth_image(
-      const msgs::sensor_msgs::Image& like, const float* z, std::size_t count) {
+  static std::shared_ptr<msgs::sensor_msgs::Image> depth_image(const msgs::sensor_msgs::Image& like,
+                                                               const float* z, std::size_t count) {
     auto image = runtime::make_sample<msgs::sensor_msgs::Image>();
     image->header.stamp = like.header.stamp;
     runtime::set_string(image->header.frame_id,
@@ -275,9 +283,9 @@ TEST(CameraLoopback, PosesOverGigEVisionEqualTheDirectSimulatorPath) {
   // matching on the direct simulator path's maps give the same poses (issue 15: within 1e-6).
   const std::string scene =
       std::string(std::getenv("AVS_SOURCE_DIR")) + "/launch_config/scenes/static_ken.yaml";
-  const testing::ContainerRun run = run_loopback(
-      ", scene: " + scene, 6.0, "{scene: " + scene + ", forward_maps: true}",
-      {matching_on("checked"), matching_on("direct")});
+  const testing::ContainerRun run =
+      run_loopback(", scene: " + scene, 6.0, "{scene: " + scene + ", forward_maps: true}",
+                   {matching_on("checked"), matching_on("direct")});
   ASSERT_TRUE(run.load_errors.empty()) << run.load_errors.front();
   ASSERT_EQ(run.status, 0);
   const auto* checker = run.find<TestCameraChecker>("checker");
@@ -297,8 +305,8 @@ TEST(CameraLoopback, PosesOverGigEVisionEqualTheDirectSimulatorPath) {
     if (it == checker->direct_poses.end()) continue;
     ++common;
     const auto& b = it->second;
-    position_m = std::max({position_m, std::abs(a[0] - b[0]), std::abs(a[1] - b[1]),
-                           std::abs(a[2] - b[2])});
+    position_m =
+        std::max({position_m, std::abs(a[0] - b[0]), std::abs(a[1] - b[1]), std::abs(a[2] - b[2])});
     // Quaternion components (q and -q are the same rotation).
     double same = 0, opposite = 0;
     for (int i = 3; i < 7; ++i) {
@@ -307,11 +315,11 @@ TEST(CameraLoopback, PosesOverGigEVisionEqualTheDirectSimulatorPath) {
     }
     orientation = std::max(orientation, std::min(same, opposite));
   }
-  std::printf("%lld maps forwarded, %zu / %zu poses (capture path / direct path), %lld common: "
-              "largest difference %.3g m, %.3g in a quaternion component\n",
-              static_cast<long long>(checker->forwarded_maps), checker->checked_poses.size(),
-              checker->direct_poses.size(), static_cast<long long>(common), position_m,
-              orientation);
+  std::printf(
+      "%lld maps forwarded, %zu / %zu poses (capture path / direct path), %lld common: "
+      "largest difference %.3g m, %.3g in a quaternion component\n",
+      static_cast<long long>(checker->forwarded_maps), checker->checked_poses.size(),
+      checker->direct_poses.size(), static_cast<long long>(common), position_m, orientation);
   EXPECT_GE(common, 5);
   EXPECT_GE(static_cast<std::int64_t>(checker->direct_poses.size()), common);
   EXPECT_LE(position_m, 1e-6);
@@ -349,6 +357,65 @@ TEST(CameraLoopback, FramesDroppedOnPurposeAreCountedAndDepthResumes) {
   EXPECT_TRUE(std::any_of(checker->depth_k.begin(), checker->depth_k.end(),
                           [](std::int64_t k) { return k > 450 + 2 * 2 * kBits; }));
 }
+
+#ifdef AVS_PROGRAM
+/// Issue 18 section 1: the camera's exposure, gain and sequencer threshold changed from another
+/// process while it streams (`avs param set camera ...`): written to the camera over GVCP and
+/// read back (AravisCamera checks that it stuck), the labelled frames go on, and a value the
+/// camera does not allow is refused with its range and changes nothing.
+TEST(CameraLoopback, ExposureGainAndThresholdChangeWhileStreaming) {
+  const std::string rate = std::to_string(kRateHz);
+  avs::testing::BackgroundContainer graph(
+      {"{type: sim_camera, name: sim_camera, parameters: {frame_rate_hz: " + rate + "}}",
+       "{type: camera, name: camera, parameters: {device_id: 127.0.0.1, trigger_mode: free_run, "
+       "frame_rate_hz: " +
+           rate + ", socket_buffer_bytes: 8000000}}"},
+      3600.0, avs::testing::TestClock::wall);
+  for (const auto& e : graph.run().load_errors) ADD_FAILURE() << e;
+  ASSERT_NE(graph.run().container, nullptr);
+  const auto labelled = [&] {
+    return count(diagnostics(graph.run(), "camera"), "frames_labelled");
+  };
+  // Waits bound the test only (at most 60 s): the counts, not the speed, are checked.
+  const auto wait_for_labelled = [&](std::int64_t above) {
+    for (int i = 0; i < 6000 && labelled() <= above; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return labelled();
+  };
+  ASSERT_GT(wait_for_labelled(0), 0) << "the camera never locked";
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("avs_camera_param_test_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const auto out = dir / "out.txt";
+  const auto err = dir / "err.txt";
+  const auto avs = [&](std::vector<std::string> words) {
+    return avs::testing::run_avs(std::move(words), out, err);
+  };
+  ASSERT_EQ(avs({"param", "set", "camera", "exposure_time_us", "2000"}), 0)
+      << avs::testing::read_file(err);
+  ASSERT_EQ(avs({"param", "set", "camera", "gain", "2"}), 0) << avs::testing::read_file(err);
+  EXPECT_NE(avs::testing::read_file(out).find("/camera: gain = 2 (was -1)"), std::string::npos)
+      << avs::testing::read_file(out);
+  ASSERT_EQ(avs({"param", "set", "camera", "threshold_psi", "30"}), 0)
+      << avs::testing::read_file(err);
+  // The camera's own range, through the same checks as at start-up; the value stays 2.
+  EXPECT_EQ(avs({"param", "set", "camera", "gain", "100000"}), 1);
+  const std::string refusal = avs::testing::read_file(err);
+  EXPECT_NE(refusal.find("= 100000 is out of range; the camera allows"), std::string::npos)
+      << refusal;
+  EXPECT_EQ(avs({"param", "get", "camera", "gain"}), 0) << avs::testing::read_file(err);
+  EXPECT_EQ(avs::testing::read_file(out), "2\n");
+  EXPECT_EQ(avs({"param", "set", "camera", "width", "256"}), 1);
+  EXPECT_NE(avs::testing::read_file(err).find("width is not dynamic"), std::string::npos)
+      << avs::testing::read_file(err);
+  // Frames are still labelled after the changes (psi 30 still sees the stripes).
+  const std::int64_t after_changes = labelled();
+  EXPECT_GT(wait_for_labelled(after_changes + 2 * kBits), after_changes + 2 * kBits);
+  EXPECT_EQ(graph.stop(), 0);
+  std::filesystem::remove_all(dir);
+}
+#endif  // AVS_PROGRAM
 
 /// What AravisCamera says when the camera refuses a configuration: one line naming the
 /// feature, the value and what the camera allows.

@@ -83,7 +83,11 @@ struct Outcome {
 };
 
 /// Feeds the deliveries and checks every released label against the truth.
-Outcome run(const std::vector<Delivery>& deliveries, SequencerConfig config = {}) {
+/// The sequencer over `deliveries`; from delivery `retune_at` on (if given) with `retuned`'s
+/// thresholds (PatternSequencer::retune, the camera component's live parameters).
+Outcome run(const std::vector<Delivery>& deliveries, SequencerConfig config = {},
+            std::optional<std::size_t> retune_at = std::nullopt,
+            const SequencerConfig& retuned = {}) {
   PatternSequencer sequencer(config);
   Outcome o;
   std::map<std::uint64_t, std::int64_t> f_of_token;
@@ -111,6 +115,9 @@ Outcome run(const std::vector<Delivery>& deliveries, SequencerConfig config = {}
   };
   std::uint64_t token = 0;
   for (const Delivery& d : deliveries) {
+    if (retune_at && static_cast<std::size_t>(&d - deliveries.data()) == *retune_at) {
+      sequencer.retune(retuned);
+    }
     CameraFrame frame;
     frame.frame_id = d.id;
     frame.timestamp_ns = d.t_ns;
@@ -322,7 +329,8 @@ TEST(PatternSequencer, SlipAfterGapsLongerThanTheBridgeIsNotLabelled) {
   // not labelled; its sum is the reference for the next pair.
   std::vector<Delivery> s = stream(0, 30 * kFramesPerCycle);
   const std::int64_t from = 4 * kFramesPerCycle, to = from + 17 * 12;
-  std::erase_if(s, [&](const Delivery& d) { return d.f >= from && d.f < to && (d.f - from) % 17 != 0; });
+  std::erase_if(
+      s, [&](const Delivery& d) { return d.f >= from && d.f < to && (d.f - from) % 17 != 0; });
   for (Delivery& d : s) {
     if (d.f >= to + 1) d.f += 1;  // the slip
   }
@@ -366,6 +374,22 @@ TEST(PatternSequencer, DarkSceneNeverLocks) {
   EXPECT_EQ(o.labelled, 0);
   EXPECT_EQ(o.stats.locks, 0);
   EXPECT_EQ(o.stats.dropped_not_locked, 6 * kFramesPerCycle);
+}
+
+TEST(PatternSequencer, ThresholdRetunedWhileRunningTakesEffectFromTheNextFrame) {
+  // Psi 255 decides no bit (Eq. 2): the structure cannot be seen and nothing locks. Retuned
+  // to 10 after 4 cycles, the sequencer locks as on a clean stream from there.
+  SequencerConfig blind;
+  blind.threshold_psi = 255;
+  const SequencerConfig normal;
+  const Outcome o = run(stream(0, 10 * kFramesPerCycle, 100), blind, 4 * kFramesPerCycle, normal);
+  expect_true_labels(o);
+  EXPECT_EQ(o.stats.locks, 1);
+  EXPECT_GE(o.first_labelled_f, 4 * kFramesPerCycle);
+  EXPECT_LE(o.first_labelled_f, 7 * kFramesPerCycle);
+  EXPECT_EQ(o.labelled, 10 * kFramesPerCycle - o.first_labelled_f);
+  const Outcome never = run(stream(0, 10 * kFramesPerCycle, 100), blind);
+  EXPECT_EQ(never.stats.locks, 0);
 }
 
 TEST(PatternSequencer, LabelledFramesDecodeToThePlane) {

@@ -385,6 +385,13 @@ void AravisCamera::start() {
   impl_->acquiring = true;
 }
 
+void AravisCamera::set_exposure_and_gain(double exposure_us, double gain) {
+  // GenICam control goes over GVCP (or the USB3 Vision control endpoint), not the stream:
+  // the capture thread's buffers are not touched.
+  if (exposure_us > 0) impl_->set_float({"ExposureTime", "ExposureTimeAbs"}, exposure_us);
+  if (gain >= 0) impl_->set_gain(gain);
+}
+
 void AravisCamera::stop() {
   if (!impl_->acquiring) return;
   impl_->acquiring = false;

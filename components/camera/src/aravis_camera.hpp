@@ -62,6 +62,11 @@ class AravisCamera {
 
   void start();
   void stop();
+  /// Writes ExposureTime (exposure_us > 0) and Gain (gain >= 0) while the camera streams (the
+  /// camera component's live parameters); 0 and -1 write nothing. Throws std::runtime_error
+  /// with the one line of a refused configuration (feature, value, what the camera allows);
+  /// a refused value changes nothing on the camera. Not thread-safe against itself.
+  void set_exposure_and_gain(double exposure_us, double gain);
   /// The next buffer (complete or not), or nothing after `timeout`.
   std::optional<CapturedFrame> next(std::chrono::milliseconds timeout);
   StreamCounters counters() const;

@@ -92,7 +92,9 @@ class CameraComponent final : public runtime::Component {
             .integer("offset_y", AVS_FIELD(offset_y), -1, 65535, "px", "OffsetY; -1: centred")
             .real("exposure_time_us", AVS_FIELD(exposure_time_us), 0.0, 1e7, "us",
                   "ExposureTime; 0: as the camera has it")
+            .live()
             .real("gain", AVS_FIELD(gain), -1.0, 1e6, "", "Gain (or GainRaw); -1: as it is")
+            .live()
             .choice("trigger_mode", AVS_FIELD(trigger_mode),
                     std::vector<std::pair<std::string, TriggerMode>>{
                         {"hardware", TriggerMode::kHardware}, {"free_run", TriggerMode::kFreeRun}},
@@ -122,6 +124,7 @@ class CameraComponent final : public runtime::Component {
                     "offset seen; camera = the camera's clock as is; host_arrival = arrival")
             .real("image_raw_rate_hz", AVS_FIELD(image_raw_rate_hz), 0.0, 100000.0, "Hz",
                   "/camera/image_raw at most this often (every frame, labelled or not); 0: off")
+            .live()
             .integer("bit_count", AVS_FIELD(sequencer.bit_count), 2, 15, "",
                      "n code bits of the projected sequence (2n frames per cycle)")
             .integer("frame_id_bits", AVS_FIELD(sequencer.frame_id_bits), 2, 64, "",
@@ -136,12 +139,16 @@ class CameraComponent final : public runtime::Component {
                      "cycles that must show the pattern structure before labelling")
             .integer("threshold_psi", AVS_FIELD(sequencer.threshold_psi), 0, 255, "",
                      "Eq. 2 threshold for the sequencer's bit transitions")
+            .live()
             .real("pair_sum_match_max", AVS_FIELD(sequencer.pair_sum_match_max), 0.0, 10.0, "",
                   "a true pair's sum differs from the previous pair's by at most this (relative)")
+            .live()
             .real("pair_sum_mismatch_min", AVS_FIELD(sequencer.pair_sum_mismatch_min), 0.0, 10.0,
                   "", "misaligned couples differ by at least this (relative)")
+            .live()
             .boolean("verify_pairs", AVS_FIELD(sequencer.verify_pairs),
                      "check each labelled pair's structure before publishing it")
+            .live()
             .integer("relock_cycle_jump", AVS_FIELD(sequencer.relock_cycle_jump), 2, 1e6, "",
                      "cycle numbers skipped (at least) after a lost lock");
     return p;
@@ -188,6 +195,24 @@ class CameraComponent final : public runtime::Component {
                s.labelled, " labelled, ", s.missing_ids, " missing ids, ", s.gaps, " gaps, ",
                s.locks, " locks, ", s.verify_failures, " pair mismatches; stream: ", c.underruns,
                " underruns, ", c.resent_packets, " resent packets");
+  }
+
+  /// The live parameters: exposure and gain are written to the camera at once (a refusal names
+  /// what the camera allows and changes nothing); the sequencer's thresholds apply from the
+  /// next frame; the /camera/image_raw rate from the next frame too.
+  void on_parameters_changed(const runtime::ParameterValues& values,
+                             const std::vector<std::string>& changed) override {
+    const CameraConfig next = params().make(values);
+    const auto is_changed = [&](const char* name) {
+      return std::find(changed.begin(), changed.end(), name) != changed.end();
+    };
+    if (is_changed("exposure_time_us") || is_changed("gain")) {
+      camera_->set_exposure_and_gain(is_changed("exposure_time_us") ? next.exposure_time_us : 0,
+                                     is_changed("gain") ? next.gain : -1);
+    }
+    image_raw_rate_hz_ = next.image_raw_rate_hz;
+    std::lock_guard lock(mutex_);  // the capture thread pushes frames under it
+    sequencer_.retune(next.sequencer);
   }
 
   std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
@@ -345,8 +370,9 @@ class CameraComponent final : public runtime::Component {
   }
 
   void publish_raw(const CapturedFrame& f, runtime::Time stamp) {
-    if (config_.image_raw_rate_hz <= 0) return;
-    const auto min_step_ns = static_cast<std::int64_t>(1e9 / config_.image_raw_rate_hz);
+    const double rate_hz = image_raw_rate_hz_.load();
+    if (rate_hz <= 0) return;
+    const auto min_step_ns = static_cast<std::int64_t>(1e9 / rate_hz);
     if (last_raw_ns_ != 0 && f.host_timestamp_ns - last_raw_ns_ < min_step_ns) return;
     last_raw_ns_ = f.host_timestamp_ns;
     auto m = lend<msgs::sensor_msgs::Image>(
@@ -373,7 +399,8 @@ class CameraComponent final : public runtime::Component {
 
   runtime::Publisher<msgs::avs_msgs::PatternFrame> pattern_;
   runtime::Publisher<msgs::sensor_msgs::Image> image_raw_;
-  CameraConfig config_;
+  CameraConfig config_;  ///< as started; the live parameters are kept apart (below)
+  std::atomic<double> image_raw_rate_hz_{config_.image_raw_rate_hz};  ///< live
   std::string frame_id_;
   int expected_width_ = config_.width;
   int expected_height_ = config_.height;

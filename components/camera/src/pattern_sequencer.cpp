@@ -95,9 +95,8 @@ Released PatternSequencer::push(const CameraFrame& frame) {
   std::int64_t dt_ns = 0;
   const bool clock_jumped = __builtin_sub_overflow(frame.timestamp_ns, last_timestamp_ns_, &dt_ns);
   const double periods = static_cast<double>(dt_ns) * 1e-9 / config_.frame_period_s;
-  const bool consistent =
-      !clock_jumped &&
-      std::abs(periods - static_cast<double>(step)) <= config_.gap_tolerance_periods;
+  const bool consistent = !clock_jumped && std::abs(periods - static_cast<double>(step)) <=
+                                               config_.gap_tolerance_periods;
   // A frame completed after newer ones has an id that was missing. An id received before,
   // with a timestamp that fits its old place, is a camera that restarted its ids and its clock
   // soon after it started (found by fuzz_pattern_sequencer: taken as late frames, the new ids
@@ -154,6 +153,13 @@ void PatternSequencer::mark_received(std::int64_t position) {
   if (position >= 0) received_[static_cast<std::size_t>(position) % received_.size()] = position;
 }
 
+void PatternSequencer::retune(const SequencerConfig& next) {
+  config_.threshold_psi = next.threshold_psi;
+  config_.pair_sum_match_max = next.pair_sum_match_max;
+  config_.pair_sum_mismatch_min = next.pair_sum_mismatch_min;
+  config_.verify_pairs = next.verify_pairs;
+}
+
 Released PatternSequencer::flush() {
   Released out;
   if (held_) {
@@ -204,7 +210,8 @@ void PatternSequencer::hunt(const CameraFrame& frame, bool continuous, Released&
     const double cycle_s = config_.frame_period_s * static_cast<double>(frames_per_cycle_);
     const double elapsed_s = std::max(
         (static_cast<double>(frame.timestamp_ns) -
-         static_cast<double>(last_emitted_timestamp_ns_)) * 1e-9,
+         static_cast<double>(last_emitted_timestamp_ns_)) *
+            1e-9,
         static_cast<double>(stats_.frames - last_emitted_frames_) * config_.frame_period_s);
     next_cycle =
         last_emitted_cycle_ +
@@ -365,7 +372,8 @@ void PatternSequencer::locked_push(const CameraFrame& frame, Released& out) {
   // may fail the check: that drops the lock (frames lost), never a label.
   const double difference =
       config_.verify_pairs
-          ? couple_sum_difference(frame, 2, 2 + static_cast<std::int64_t>(config_.max_bridged_gap_frames))
+          ? couple_sum_difference(frame, 2,
+                                  2 + static_cast<std::int64_t>(config_.max_bridged_gap_frames))
           : -1;
   if (config_.verify_pairs && difference < 0) {
     // Nothing to check it against (every pair since the last checked one lost in gaps for

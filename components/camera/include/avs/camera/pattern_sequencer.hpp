@@ -117,9 +117,9 @@ struct SequencerStats {
   std::int64_t duplicates = 0;
   std::int64_t late_frames = 0;  ///< older ids arriving after newer ones; dropped
   std::int64_t dropped_unpaired = 0;
-  std::int64_t verify_failures = 0;  ///< pairs whose structure did not match (lock dropped)
+  std::int64_t verify_failures = 0;   ///< pairs whose structure did not match (lock dropped)
   std::int64_t unverified_pairs = 0;  ///< pairs with nothing to check them against: dropped
-  std::int64_t missing_ids = 0;      ///< ids skipped by forward gaps
+  std::int64_t missing_ids = 0;       ///< ids skipped by forward gaps
   std::int64_t gaps = 0;          ///< discontinuities of any kind (id skips, time steps, restarts)
   std::int64_t bridged_gaps = 0;  ///< gaps crossed while staying locked
   std::int64_t restarts = 0;      ///< ids or timestamps going back
@@ -136,6 +136,10 @@ class PatternSequencer {
   Released push(const CameraFrame& frame);
   /// Releases the held frame, if any, as dropped (end of stream).
   Released flush();
+  /// Takes the thresholds of `next` (threshold_psi, pair_sum_match_max, pair_sum_mismatch_min,
+  /// verify_pairs: the camera component's live parameters) from the next frame on; the lock,
+  /// the ids and the frame held stay. The structure settings (bits, ids, periods) stay too.
+  void retune(const SequencerConfig& next);
 
   bool locked() const { return locked_; }
   const SequencerStats& stats() const { return stats_; }
@@ -193,7 +197,6 @@ class PatternSequencer {
 
   // Locked: sequence number (cycle * 2n + 2 * bit + polarity) at position origin_position_.
   bool locked_ = false;
-  bool ever_locked_ = false;
   std::int64_t origin_sequence_ = 0;
   std::int64_t origin_position_ = 0;
   std::int64_t last_emitted_cycle_ = -1;
