@@ -24,7 +24,8 @@ Options::Options(std::string bench, const std::vector<std::string>& args,
     : bench_(std::move(bench)) {
   const std::vector<std::string> words = option_words(args);
   for (std::size_t i = 0; i < words.size(); ++i) {
-    if (std::find(flags.begin(), flags.end(), words[i]) != flags.end()) {
+    if (words[i] == "--help" || words[i] == "-h" ||
+        std::find(flags.begin(), flags.end(), words[i]) != flags.end()) {
       given_[words[i]] = "";
       used_[words[i]] = false;
       continue;
@@ -57,9 +58,10 @@ void Options::refuse(const std::string& key, const std::string& wanted,
 }
 
 double Options::number(const std::string& key, double fallback, double min, double max) {
+  const std::string wanted = "a number in [" + shown(min) + ", " + shown(max) + "]";
+  help_.push_back(key + " N  " + wanted + " (default " + shown(fallback) + ")");
   const std::string* text = value(key);
   if (text == nullptr) return fallback;
-  const std::string wanted = "a number in [" + shown(min) + ", " + shown(max) + "]";
   errno = 0;
   char* end = nullptr;
   const double v = std::strtod(text->c_str(), &end);
@@ -72,10 +74,11 @@ double Options::number(const std::string& key, double fallback, double min, doub
 
 long long Options::integer(const std::string& key, long long fallback, long long min,
                            long long max) {
-  const std::string* text = value(key);
-  if (text == nullptr) return fallback;
   const std::string wanted =
       "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+  help_.push_back(key + " N  " + wanted + " (default " + std::to_string(fallback) + ")");
+  const std::string* text = value(key);
+  if (text == nullptr) return fallback;
   errno = 0;
   char* end = nullptr;
   const long long v = std::strtoll(text->c_str(), &end, 10);
@@ -87,15 +90,35 @@ long long Options::integer(const std::string& key, long long fallback, long long
 }
 
 bool Options::flag(const std::string& key) {
+  if (key != "--help" && key != "-h") help_.push_back(key + "  a flag");
   return value(key) != nullptr;
 }
 
 std::string Options::text(const std::string& key, std::string fallback) {
+  help_.push_back(key + " TEXT" +
+                  (fallback.empty() ? std::string() : "  (default " + fallback + ")"));
   const std::string* text = value(key);
   return text == nullptr ? std::move(fallback) : *text;
 }
 
 void Options::finish() const {
+  const auto unanswered = [&](const char* key) {
+    const auto it = used_.find(key);
+    return it != used_.end() && !it->second;
+  };
+  if (unanswered("--help") || unanswered("-h")) {
+    std::string text = "avs bench " + bench_ + " options (as --key value or --key=value):\n";
+    for (const std::string& line : help_) {
+      const std::size_t gap = line.find("  ");
+      text += "  " + line.substr(0, gap);
+      if (gap != std::string::npos) {
+        text += std::string(gap < 28 ? 28 - gap : 1, ' ') + line.substr(gap + 2);
+      }
+      text += "\n";
+    }
+    if (help_.empty()) text += "  (none)\n";
+    throw HelpRequested(text);
+  }
   std::string unknown;
   for (const auto& [key, used] : used_) {
     if (!used) unknown += (unknown.empty() ? "" : ", ") + key;

@@ -34,6 +34,13 @@ if "$avs" bench 2>/dev/null | grep -q '^servo'; then
   refused "avs bench matching: --poses wants an integer in [1, 100000], got 'nan'" bench matching --poses nan
   refused "avs bench bag: --duration wants a number in [0.1, 3600], got '-1'" bench bag --duration=-1
   refused "avs bench servo: unknown option --sconds" bench servo --sconds=3
+  # `avs bench NAME --help` is the benchmark's help, not `avs bench`'s, and runs nothing.
+  help=$(timeout 10 "$avs" bench servo --help) || fail "avs bench servo --help failed"
+  grep -qF -- "--seconds N                 a number in [0.1, 3600] (default 3)" <<<"$help" ||
+    fail "avs bench servo --help: $help"
+  help=$(timeout 10 "$avs" bench decode -h) || fail "avs bench decode -h failed"
+  grep -qF -- "--updates N" <<<"$help" || fail "avs bench decode -h: $help"
+  echo "ok: avs bench NAME --help lists the benchmark's options"
 fi
 
 "$avs" topic echo /no_such_topic --wait 60 >/dev/null 2>&1 &

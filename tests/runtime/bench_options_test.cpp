@@ -53,5 +53,27 @@ TEST(BenchOptions, UnknownOrValuelessOptionsAreNamed) {
   EXPECT_EQ(refusal({"5"}), "avs bench servo: expected an option (--name value), got '5'");
 }
 
+TEST(BenchOptions, HelpListsTheOptionsAskedForWithRangesAndDefaultsInsteadOfRunning) {
+  Options options("servo", {"--help"});
+  options.number("--seconds", 3.0, 0.1, 3600.0);
+  options.integer("--frames", 300, 10, 1000000);
+  options.text("--model", "ken");
+  std::string help;
+  try {
+    options.finish();
+  } catch (const HelpRequested& h) {
+    help = h.what();
+  }
+  EXPECT_EQ(help,
+            "avs bench servo options (as --key value or --key=value):\n"
+            "  --seconds N                 a number in [0.1, 3600] (default 3)\n"
+            "  --frames N                  an integer in [10, 1000000] (default 300)\n"
+            "  --model TEXT                (default ken)\n");
+  // A benchmark that answers --help itself (flag("--help")) gets no HelpRequested.
+  Options own("bag", {"-h"}, {"--keep"});
+  EXPECT_TRUE(own.flag("-h"));
+  EXPECT_NO_THROW(own.finish());
+}
+
 }  // namespace
 }  // namespace avs::bench

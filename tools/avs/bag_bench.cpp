@@ -61,7 +61,8 @@ BenchArgs parse_args(const std::vector<std::string>& raw) {
         "publisher process for S seconds per compression; files go to DIR (default $TMPDIR or "
         "/tmp)\n"
         "and are deleted unless --keep. The publisher is reliable KEEP_ALL, or KEEP_LAST N with\n"
-        "--publisher-history=N (to show the losses a reader is not told about).\n");
+        "--publisher-history=N (to show the losses a reader is not told about).\n"
+        "  --domain=ID  DDS domain id (default: $AVS_DOMAIN_ID or 0)\n");
     std::exit(0);
   }
   a.duration_s = given.number("--duration", a.duration_s, 0.1, 3600.0);
@@ -71,7 +72,7 @@ BenchArgs parse_args(const std::vector<std::string>& raw) {
   a.dir = given.text("--dir", a.dir);
   a.history = static_cast<int>(given.integer("--publisher-history", a.history, 0, 1000000));
   a.keep = given.flag("--keep");
-  a.domain = static_cast<int>(given.integer("--domain", a.domain, -1, 232));
+  a.domain = static_cast<int>(given.integer("--domain", a.domain, 0, 232));
   if (const std::string list = given.text("--compression", ""); !list.empty()) {
     a.compressions.clear();
     std::stringstream ss(list);

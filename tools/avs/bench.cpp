@@ -57,7 +57,11 @@ void add_bench_command(Command& app) {
   auto* cmd = app.add_subcommand("bench", "Benchmarks against a peer measured in the same run");
   static std::string name;
   static bool json = false;
+  static bool help = false;
   cmd->add_option("name", name, "benchmark name (omit to list them)");
+  // Our own help flag: `avs bench NAME --help` is the benchmark's help (its options with ranges
+  // and defaults), `avs bench --help` this one.
+  cmd->own_help_flag(help, "this help; after NAME: the benchmark's options");
   cmd->add_flag("--json", json, "print one JSON object (keys carry units)");
   // Everything after the name goes to the benchmark in the order given (--model FILE, ...).
   cmd->prefix_command();
@@ -65,6 +69,10 @@ void add_bench_command(Command& app) {
               "Arguments after NAME go to the benchmark in order, e.g. avs bench matching "
               "--model my.ply --json");
   cmd->callback([cmd] {
+    if (help && name.empty()) {
+      std::cout << cmd->help_text();
+      return;
+    }
     if (!kHaveBenchmarks) {
       std::cerr << "avs bench: " << kNoBenchmarks << "\n";
       exit_status() = name.empty() ? 0 : 2;
@@ -84,10 +92,17 @@ void add_bench_command(Command& app) {
       }
       return;
     }
+    if (help) args.push_back("--help");
     for (const auto& b : bench::bench_registry()) {
       if (b.name != name) continue;
-      const bench::Report report = b.run(args);
-      json ? print_json(report) : print_table(report);
+      try {
+        const bench::Report report = b.run(args);
+        json ? print_json(report) : print_table(report);
+      } catch (const bench::HelpRequested& h) {
+        std::cout << "avs bench " << b.name << ": " << b.description << "\n"
+                  << h.what()
+                  << "  --json                      print one JSON object (keys carry units)\n";
+      }
       return;
     }
     std::cerr << "avs bench: no benchmark '" << name << "' (run `avs bench` to list them)\n";

@@ -160,11 +160,27 @@ Command* Command::prefix_command() {
   return this;
 }
 
-std::vector<std::string> Command::remaining() const { return app_->remaining(); }
+std::vector<std::string> Command::remaining() const {
+  return app_->remaining();
+}
 
-std::size_t Command::count(const std::string& name) const { return app_->count(name); }
+Command* Command::own_help_flag(bool& value, std::string description) {
+  app_->set_help_flag();
+  add_flag("-h,--help", value, std::move(description));
+  return this;
+}
 
-void Command::parse(int argc, const char* const* argv) { app_->parse(argc, argv); }
+std::string Command::help_text() const {
+  return app_->help();
+}
+
+std::size_t Command::count(const std::string& name) const {
+  return app_->count(name);
+}
+
+void Command::parse(int argc, const char* const* argv) {
+  app_->parse(argc, argv);
+}
 
 std::optional<int> Command::parse_or_explain(int argc, const char* const* argv) {
   // A first word that is no command: say so and list the commands (CLI11 would only say

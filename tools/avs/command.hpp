@@ -62,8 +62,7 @@ class Command {
   Option* add_option(std::string name, std::string& value, std::string description = "");
   Option* add_option(std::string name, std::vector<std::string>& values,
                      std::string description = "");
-  Option* add_option(std::string name, std::filesystem::path& value,
-                     std::string description = "");
+  Option* add_option(std::string name, std::filesystem::path& value, std::string description = "");
   Option* add_option(std::string name, double& value, std::string description = "");
   Option* add_option(std::string name, int& value, std::string description = "");
   Option* add_option(std::string name, unsigned& value, std::string description = "");
@@ -79,6 +78,10 @@ class Command {
   /// Words after the positionals are left for remaining() (CLI::App::prefix_command).
   Command* prefix_command();
   std::vector<std::string> remaining() const;
+  /// Replaces CLI11's -h/--help (print and exit) by a flag the callback reads, for a command
+  /// that passes help on (`avs bench NAME --help`); help_text() is what --help would print.
+  Command* own_help_flag(bool& value, std::string description);
+  std::string help_text() const;
   /// How many times the option `name` (e.g. "--width") was given.
   std::size_t count(const std::string& name) const;
 

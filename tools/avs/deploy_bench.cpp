@@ -332,7 +332,7 @@ void add_transport_peer_command(Command& app) {
   cmd->add_option("--count", o.count, "samples")->capture_default_str();
   cmd->add_option("--rate", o.rate_hz, "Hz")->capture_default_str();
   cmd->add_option("--bytes", o.bytes, "image bytes")->capture_default_str();
-  cmd->add_option("--domain", o.domain, "DDS domain")->capture_default_str();
+  add_domain_option(cmd, o.domain);
   cmd->callback([] {
     try {
       exit_status() = o.role == "pub" ? run_pub(o) : run_sub(o);

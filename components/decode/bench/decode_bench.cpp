@@ -195,28 +195,10 @@ OpenCvTiming time_opencv(const SensorGeometry& g, const SyntheticScene& scene, i
 }
 
 bench::Report run(const std::vector<std::string>& args) {
-  int updates = 300, opencv_runs = 5;
-  // --updates N / --updates=N, --opencv-runs N / --opencv-runs=N.
-  const auto number = [](const std::string& option, const std::string& text) {
-    try {
-      std::size_t used = 0;
-      const int value = std::stoi(text, &used);
-      if (used == text.size() && value > 0) return value;
-    } catch (const std::exception&) {
-    }
-    throw std::invalid_argument("bench decode: " + option + " needs a positive integer, got '" +
-                                text + "' (write " + option + "=N)");
-  };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    for (const std::string option : {"--updates", "--opencv-runs"}) {
-      int* target = option == "--updates" ? &updates : &opencv_runs;
-      if (args[i].rfind(option + "=", 0) == 0) {
-        *target = number(option, args[i].substr(option.size() + 1));
-      } else if (args[i] == option) {
-        *target = number(option, i + 1 < args.size() ? args[i + 1] : std::string());
-      }
-    }
-  }
+  bench::Options options("decode", args);
+  const int updates = static_cast<int>(options.integer("--updates", 300, 1, 1000000));
+  const int opencv_runs = static_cast<int>(options.integer("--opencv-runs", 5, 1, 100000));
+  options.finish();
   DecoderConfig config;
   PlaneSceneConfig scene_config;
   scene_config.seed = 5;

@@ -4,6 +4,7 @@
 // with AVS_REGISTER_BENCH in a component library.
 #pragma once
 
+#include <exception>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -57,11 +58,23 @@ inline std::vector<std::string> option_words(const std::vector<std::string>& arg
   return words;
 }
 
+/// Thrown by Options::finish() when `--help` (or `-h`) was given and the benchmark did not
+/// answer it itself: what() is the list of the options it asked for, with ranges and defaults.
+class HelpRequested : public std::exception {
+ public:
+  explicit HelpRequested(std::string text) : text_(std::move(text)) {}
+  const char* what() const noexcept override { return text_.c_str(); }
+
+ private:
+  std::string text_;
+};
+
 /// A benchmark's options read with their ranges: numbers must be finite, whole where an integer
 /// is asked for, and in range, or std::invalid_argument says which benchmark, option and range
 /// ("avs bench servo: --rate wants a number in [1, 100000], got 'abc'"), never a bare "stod".
 /// Values come as "--key value" or "--key=value" (option_words()); `flags` take no value;
-/// finish() refuses options no one asked for.
+/// finish() refuses options no one asked for, and answers `--help` / `-h` (always flags) with
+/// the options asked for (HelpRequested).
 class Options {
  public:
   Options(std::string bench, const std::vector<std::string>& args,
@@ -72,7 +85,8 @@ class Options {
   double number(const std::string& key, double fallback, double min, double max);
   long long integer(const std::string& key, long long fallback, long long min, long long max);
   std::string text(const std::string& key, std::string fallback);
-  /// Throws for an option that none of number(), integer(), text() asked for.
+  /// Throws HelpRequested for an unanswered --help, std::invalid_argument for an option that
+  /// none of number(), integer(), text(), flag() asked for.
   void finish() const;
 
  private:
@@ -85,6 +99,7 @@ class Options {
   std::map<std::string, std::string> given_;
   std::map<std::string, bool> used_;
   std::vector<std::string> asked_;  ///< every key asked for, in order (for finish()'s message)
+  std::vector<std::string> help_;   ///< "--key  what it takes (default)", in the order asked
 };
 
 /// The 1-, 5- and 15-minute load averages as /proc/loadavg gives them ("0.52 0.61 0.70"),
@@ -103,6 +118,6 @@ inline bool register_bench(std::string name, std::string description, BenchFunct
 
 }  // namespace avs::bench
 
-#define AVS_REGISTER_BENCH(ident, name, description, fn) \
+#define AVS_REGISTER_BENCH(ident, name, description, fn)            \
   [[maybe_unused]] static const bool avs_bench_registered_##ident = \
       ::avs::bench::register_bench(name, description, fn)
