@@ -5,11 +5,13 @@
 // ground truth and identical image checksums. DDS domain and Modbus ports leased per test
 // process (tests/support/include/avs/testing/test_domain.hpp).
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <string>
 #include <thread>
@@ -146,6 +148,48 @@ class TestSimRecorder final : public runtime::Component {
 
 AVS_REGISTER_COMPONENT(TestSimRecorder);
 
+/// Publishes /sim/head_state samples the renderer cannot use, one per `period_ms`: pan NaN,
+/// tilt +inf, a NaN rate, no tilt joint, in turn (issue 20 section 2).
+class TestBadHeadState final : public runtime::Component {
+ public:
+  static ComponentSpec spec() {
+    return {.type = "test_bad_head_state",
+            .description = "tests: malformed /sim/head_state samples",
+            .parameters = {},
+            .publishes = {runtime::port<msgs::sensor_msgs::JointState>("head", "/sim/head_state")},
+            .subscribes = {}};
+  }
+  explicit TestBadHeadState(ComponentContext& ctx)
+      : Component(ctx), head_(ctx.publisher<msgs::sensor_msgs::JointState>("head")) {}
+  void on_activate() override {
+    context().create_timer(std::chrono::milliseconds(7), [this] { tick(); });
+  }
+  int sent = 0;
+
+ private:
+  void tick() {
+    const int kind = sent % 4;
+    auto m = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    runtime::to_ros_time(context().now(), m->header.stamp);
+    const std::uint32_t n = kind == 3 ? 1 : 2;
+    runtime::resize_sequence(m->name, n);
+    runtime::resize_sequence(m->position, n);
+    runtime::resize_sequence(m->velocity, n);
+    runtime::set_string(m->name._buffer[0], "pan");
+    if (n > 1) runtime::set_string(m->name._buffer[1], "tilt");
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    m->position._buffer[0] = kind == 0 ? nan : 0.1;
+    if (n > 1) m->position._buffer[1] = kind == 1 ? std::numeric_limits<double>::infinity() : 0.1;
+    m->velocity._buffer[0] = kind == 2 ? nan : 0.0;
+    if (n > 1) m->velocity._buffer[1] = 0.0;
+    head_.publish(std::move(m));
+    ++sent;
+  }
+  runtime::Publisher<msgs::sensor_msgs::JointState> head_;
+};
+
+AVS_REGISTER_COMPONENT(TestBadHeadState);
+
 struct GraphRun {
   std::unique_ptr<graph::Graph> graph;
   std::unique_ptr<runtime::Container> container;
@@ -254,6 +298,41 @@ TEST(SimSceneGraph, FramesCarryTheGrayCodeScheduleAndGroundTruthMatchesSceneAndH
     EXPECT_EQ(timing[k].first, frames[k].stamp_ns);
     EXPECT_EQ(timing[k].second, "render");
     EXPECT_GT(run.recorder->timing_ms[k], 0.0);
+  }
+}
+
+TEST(SimSceneGraph, MalformedHeadStatesAreRejectedCountedAndNeverRendered) {
+  // Between the amplifier's good head states: NaN and infinite angles, a NaN rate and a state
+  // without tilt. Before, a NaN pan went into the renderer's head pose and every frame after.
+  setenv("AVS_SOURCE_DIR", AVS_TEST_SOURCE_DIR, 1);
+  avs::testing::ContainerRun ran = avs::testing::run_lockstep_container(
+      {"{type: sim_amplifier, name: amplifier, parameters: {port: " +
+           std::to_string(avs::testing::test_tcp_port(0)) + "}}",
+       "{type: test_bad_head_state, name: bad}",
+       "{type: sim_scene, name: scene, parameters: " + kSwingScene + "}",
+       "{type: test_sim_recorder, name: recorder}"},
+      0.1);
+  for (const auto& e : ran.load_errors) ADD_FAILURE() << e;
+  ASSERT_EQ(ran.status, 0);
+  const auto* bad = ran.find<TestBadHeadState>("bad");
+  const auto* recorder = ran.find<TestSimRecorder>("recorder");
+  ASSERT_NE(bad, nullptr);
+  ASSERT_NE(recorder, nullptr);
+  ASSERT_GE(bad->sent, 8);
+  std::string rejected;
+  for (const auto& [key, value] : ran.container->find_component("scene")->diagnostic_values()) {
+    if (key == "rejected_samples") rejected = value;
+  }
+  // Every bad sample sent before the scene's last callback: all but possibly the last one.
+  EXPECT_GE(std::stoi(rejected), bad->sent - 1);
+  EXPECT_LE(std::stoi(rejected), bad->sent);
+  ASSERT_FALSE(recorder->frames.empty());
+  for (const FrameRecord& f : recorder->frames) {
+    ASSERT_TRUE(std::isfinite(f.pan_rad) && std::isfinite(f.tilt_rad)) << f.stamp_ns;
+  }
+  for (const TruthRecord& t : recorder->truths) {
+    ASSERT_TRUE(std::isfinite(t.pan_rad) && std::isfinite(t.tilt_rad)) << t.stamp_ns;
+    ASSERT_TRUE(t.T_camera_object.matrix().allFinite()) << t.stamp_ns;
   }
 }
 

@@ -19,6 +19,7 @@
 #include "avs/geometry/frames.hpp"
 #include "avs/msg/convert.hpp"
 #include "avs/runtime/component.hpp"
+#include "avs/runtime/rejections.hpp"
 #include "avs/sim/scene_yaml.hpp"
 #include "avs/sim/simulator.hpp"
 #include "scene_path.hpp"
@@ -159,7 +160,8 @@ class SimScene final : public runtime::Component {
         pattern_(ctx.publisher<msgs::avs_msgs::PatternFrame>("pattern")),
         truth_(ctx.publisher<msgs::avs_msgs::GroundTruth>("ground_truth")),
         timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
-        start_time_s_(ctx.param<double>("start_time_s")) {
+        start_time_s_(ctx.param<double>("start_time_s")),
+        rejected_(ctx.log(), "/sim/head_state") {
     SceneFile file = load(ctx);
     sim_ = std::make_unique<Simulator>(std::move(file.config), std::move(file.scene));
     head_.pan_rad = ctx.param<double>("initial_pan_rad");
@@ -180,6 +182,10 @@ class SimScene final : public runtime::Component {
     const double rate = sim_->config().frame_rate_hz;
     const auto period = runtime::Duration(static_cast<std::int64_t>(std::llround(1e9 / rate)));
     timer_ = context().create_timer(period, [this] { tick(); });
+  }
+
+  std::vector<std::pair<std::string, std::string>> diagnostic_values() const override {
+    return {rejected_.diagnostic()};
   }
 
   void on_deactivate() override {
@@ -270,27 +276,31 @@ class SimScene final : public runtime::Component {
     return file;
   }
 
+  /// A head state the renderer cannot use (no pan or tilt joint, a non-finite angle or rate)
+  /// is rejected, counted and logged (rate-limited); the last good one stays (issue 20 2).
   void on_head_state(const msgs::sensor_msgs::JointState& m) {
     bool pan = false, tilt = false;
     HeadState h = head_;
     for (std::uint32_t i = 0; i < m.name._length && i < m.position._length; ++i) {
       const std::string_view name = runtime::get_string(m.name._buffer[i]);
       const double v = i < m.velocity._length ? m.velocity._buffer[i] : 0.0;
+      if (name != "pan" && name != "tilt") continue;
+      if (!std::isfinite(m.position._buffer[i]) || !std::isfinite(v)) {
+        rejected_.reject(std::string(name) + " position or velocity not finite");
+        return;
+      }
       if (name == "pan") {
         h.pan_rad = m.position._buffer[i];
         h.pan_rate_rad_s = v;
         pan = true;
-      } else if (name == "tilt") {
+      } else {
         h.tilt_rad = m.position._buffer[i];
         h.tilt_rate_rad_s = v;
         tilt = true;
       }
     }
     if (!pan || !tilt) {
-      if (!warned_names_) {
-        log().warn("/sim/head_state without joints named 'pan' and 'tilt': ignored");
-        warned_names_ = true;
-      }
+      rejected_.reject("no joints named 'pan' and 'tilt' (with positions)");
       return;
     }
     head_ = h;
@@ -387,12 +397,12 @@ class SimScene final : public runtime::Component {
   runtime::Publisher<msgs::avs_msgs::GroundTruth> truth_;
   runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
   double start_time_s_;
+  runtime::SampleRejections rejected_;  ///< /sim/head_state samples not used
   std::string scene_name_;
   std::unique_ptr<Simulator> sim_;
   HeadState head_;
   runtime::Time head_stamp_;
   bool have_head_ = false;
-  bool warned_names_ = false;
   std::uint64_t frames_ = 0;
   runtime::Time first_stamp_, last_stamp_;
   std::vector<double> render_ms_;
