@@ -27,6 +27,15 @@ refused "--window: Value 0 not in range" topic hz /chatter --window 0
 refused "--compression-level: Value 99999 not in range" bag record /chatter -o /tmp/x.mcap --compression-level 99999
 refused "--duration: Value -1 not in range" view --duration -1
 refused "--queue-depth: Value 0 not in range" view --queue-depth 0
+refused "--view-port: Value 70000 not in range" demo --view --view-port 70000
+refused "--bits: Value 40 not in range" patterns --bits 40 --out /nonexistent
+refused "--first-row: Value -3 not in range" patterns --first-row -3 --out /nonexistent
+if "$avs" calib --help 2>/dev/null | grep -q capture; then
+  refused "--generate: Value 0 not in range" calib capture --generate 0 --out /nonexistent
+  refused "--near: Value -1 not in range" calib capture --generate 4 --near -1 --out /nonexistent
+  refused "--noise: Value 1e6 not in range" calib bench --noise 1e6
+  refused "--min-coverage: Value 2 not in range" calib solve /nonexistent --out x.yaml --min-coverage 2
+fi
 # The benchmarks' own options (bench::Options): the benchmark, option and range, never "stod".
 if "$avs" bench 2>/dev/null | grep -q '^servo'; then
   refused "avs bench servo: --rate wants a number in [1, 100000], got 'abc'" bench servo --rate abc

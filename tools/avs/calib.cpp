@@ -283,22 +283,31 @@ void add_calib_command(Command& app) {
       ->capture_default_str();
   capture->add_option("--poses", c.poses, "board-pose YAML (board and a list of poses)")
       ->check_existing_file();
-  capture->add_option("--generate", c.generate, "or: a seeded spread of N board poses");
+  capture->add_option("--generate", c.generate, "or: a seeded spread of N board poses")
+      ->check_range(1, 10000);
   capture->add_option("--near", c.near_m, "nearest board distance for --generate, m")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0.05, 100);
   capture->add_option("--far", c.far_m, "farthest board distance for --generate, m")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0.05, 100);
   capture->add_option("--max-tilt", c.max_tilt_deg, "board tilt for --generate, deg")
-      ->capture_default_str();
-  capture->add_option("--seed", c.seed, "poses and sensor noise seed")->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0, 80);
+  capture->add_option("--seed", c.seed, "poses and sensor noise seed")
+      ->capture_default_str()
+      ->check_range(0, 4294967295.0);
   capture
       ->add_option("--calibration", c.calibration,
                    "the simulated rig's true calibration (default: the bench's sensor, "
                    "distortion on both lenses)")
       ->check_existing_file();
-  capture->add_option("--noise", c.noise_dn, "sensor noise sigma, DN")->capture_default_str();
+  capture->add_option("--noise", c.noise_dn, "sensor noise sigma, DN")
+      ->capture_default_str()
+      ->check_range(0, 255);
   capture->add_option("--pixels-per-code", c.pixels_per_code, "DMD pixels per code stripe")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1, 64);
   capture->callback([] { guarded("capture", [] { return run_capture(c); }); });
 
   static SolveOptions s;
@@ -312,15 +321,19 @@ void add_calib_command(Command& app) {
   solve->add_option("--report", s.report,
                     "report folder (default: calibration_report beside --out)");
   solve->add_option("--min-views", s.min_views, "refuse with fewer usable views")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1, 10000);
   solve->add_option("--max-camera-rms", s.max_camera_rms_px, "refuse above, px")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0.001, 1000);
   solve->add_option("--max-projector-rms", s.max_projector_rms_px, "refuse above, px")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0.001, 1000);
   solve
       ->add_option("--min-coverage", s.min_coverage,
                    "refuse below this fraction of a 4x4 grid reached by corners")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0, 1);
   solve->callback([] { guarded("solve", [] { return run_solve(s); }); });
 
   static BenchOptions b;
@@ -329,9 +342,15 @@ void add_calib_command(Command& app) {
       "Accuracy against simulator ground truth: seeded captures, solve, errors of the result "
       "and the depth RMS of a plane decoded with it");
   bench->add_flag("--json", b.json, "print one JSON object");
-  bench->add_option("--views", b.views, "board poses")->capture_default_str();
-  bench->add_option("--seed", b.seed, "poses and noise seed")->capture_default_str();
-  bench->add_option("--noise", b.noise_dn, "sensor noise sigma, DN")->capture_default_str();
+  bench->add_option("--views", b.views, "board poses")
+      ->capture_default_str()
+      ->check_range(1, 10000);
+  bench->add_option("--seed", b.seed, "poses and noise seed")
+      ->capture_default_str()
+      ->check_range(0, 4294967295.0);
+  bench->add_option("--noise", b.noise_dn, "sensor noise sigma, DN")
+      ->capture_default_str()
+      ->check_range(0, 255);
   bench->callback([] { guarded("bench", [] { return run_bench(b); }); });
 }
 

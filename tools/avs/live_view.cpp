@@ -10,14 +10,14 @@ void add_live_view_options(Command* cmd, LiveViewFlags& flags, const std::string
       "--view", flags.enabled,
       "serve " + what + " live (avs view: Foxglove WebSocket and the page, docs/view.md)");
   cmd->add_option("--view-port", flags.port, "port of --view (0: any free port)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(0, 65535);
 }
 
 std::unique_ptr<view::View> start_live_view(const LiveViewFlags& flags, int domain,
                                             const std::string& partition, const std::string& who,
                                             std::ostream& out, const std::string& page_query) {
   if (!flags.enabled) return nullptr;
-  if (flags.port > 65535) throw runtime::Error(who + ": --view-port must be in [0, 65535]");
   view::ViewOptions o;
   o.domain = domain;
   o.partition = partition;

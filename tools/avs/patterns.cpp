@@ -172,12 +172,18 @@ void add_patterns_command(Command& app) {
   cmd->add_option("--out", o.out, "output folder (created)")->required();
   cmd->add_option("--calibration", o.calibration,
                   "sensor geometry YAML: projector size and code layout from it");
-  cmd->add_option("--bits", o.bits, "n, code bits (MSB = bit 0)")->capture_default_str();
-  cmd->add_option("--codes", o.codes, "codes used (at most 2^bits)")->capture_default_str();
+  cmd->add_option("--bits", o.bits, "n, code bits (MSB = bit 0)")
+      ->capture_default_str()
+      ->check_range(1, 15);
+  cmd->add_option("--codes", o.codes, "codes used (at most 2^bits)")
+      ->capture_default_str()
+      ->check_range(2, 32768);
   cmd->add_option("--rows", o.rows, "projector rows carrying codes (a multiple of --codes)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check_range(1, 16384);
   cmd->add_option("--first-row", o.first_row,
-                  "projector row where code 0 starts (default: coded rows centred)");
+                  "projector row where code 0 starts (default: coded rows centred)")
+      ->check_range(0, 16383);
   cmd->add_option("--width", o.width, "projector width, pixels")
       ->capture_default_str()
       ->check_range(1, 16384);
