@@ -36,6 +36,19 @@ if "$avs" calib --help 2>/dev/null | grep -q capture; then
   refused "--noise: Value 1e6 not in range" calib bench --noise 1e6
   refused "--min-coverage: Value 2 not in range" calib solve /nonexistent --out x.yaml --min-coverage 2
 fi
+# Every numeric option of every command and subcommand shows its range in --help (CLI11's
+# type name becomes "INT in [a, b]" with check_range): none is accepted unchecked.
+unranged=
+for c in $("$avs" --help | awk '/^Subcommands:/{f=1; next} f && NF {print $1}'); do
+  subs=$("$avs" "$c" --help 2>/dev/null | awk '/^Subcommands:/{f=1; next} f && NF {print $1}')
+  for s in ${subs:-""}; do
+    # shellcheck disable=SC2086
+    lines=$("$avs" "$c" $s --help 2>/dev/null | grep -E ' (INT|UINT|FLOAT)( |=|$)' | grep -v ' in \[') || true
+    [ -n "$lines" ] && unranged+="avs $c $s:"$'\n'"$lines"$'\n'
+  done
+done
+[ -z "$unranged" ] || fail "numeric options without a range:"$'\n'"$unranged"
+echo "ok: every numeric option of every command has a range"
 # The benchmarks' own options (bench::Options): the benchmark, option and range, never "stod".
 if "$avs" bench 2>/dev/null | grep -q '^servo'; then
   refused "avs bench servo: --rate wants a number in [1, 100000], got 'abc'" bench servo --rate abc
