@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <sstream>
 
 #include "avs/runtime/dds.hpp"
 #include "avs/runtime/raw_topic.hpp"
@@ -23,6 +24,14 @@
 namespace avs::runtime {
 
 namespace {
+
+/// A measured figure on /diagnostics: 6 significant digits ("999.971", "1000", "0.0123"), not
+/// std::to_string's fixed 6 decimals ("1000.000000").
+std::string diagnostic_number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
 
 /// Samples posted to one subscription's lane and those skipped there (overload, see
 /// LocalSubscription::keep_last). Shared by the posted callbacks and the component's host.
@@ -629,21 +638,21 @@ void Container::Impl::publish_diagnostics(dds::Writer& writer) {
     const std::pair<const char*, std::string> values[] = {
         {"state", failed ? "failed" : (running ? "active" : "inactive")},
         {"callbacks", std::to_string(stats.callbacks)},
-        {"rate_hz",
-         std::to_string(interval_s > 0 ? static_cast<double>(stats.callbacks) / interval_s : 0.0)},
-        {"callback_ms_mean", std::to_string(mean_ms)},
-        {"callback_ms_max", std::to_string(stats.max_ms)}};
+        {"rate_hz", diagnostic_number(
+                        interval_s > 0 ? static_cast<double>(stats.callbacks) / interval_s : 0.0)},
+        {"callback_ms_mean", diagnostic_number(mean_ms)},
+        {"callback_ms_max", diagnostic_number(stats.max_ms)}};
     constexpr std::size_t kOwn = std::size(values);
     std::vector<std::pair<std::string, std::string>> extra;
     // The slowest timer against its configured rate (timer-driven components): WARN below 95 %.
     if (const auto& timer = host.last_timer_check) {
-      extra.emplace_back("timer_rate_hz", std::to_string(timer->achieved_hz));
-      extra.emplace_back("timer_configured_hz", std::to_string(timer->configured_hz));
+      extra.emplace_back("timer_rate_hz", diagnostic_number(timer->achieved_hz));
+      extra.emplace_back("timer_configured_hz", diagnostic_number(timer->configured_hz));
       if (timer->below && !failed) {
         status.level = 1;  // DiagnosticStatus WARN
         set_string(status.message, "active, timer below 95 % of its configured rate (" +
-                                       std::to_string(timer->achieved_hz) + " of " +
-                                       std::to_string(timer->configured_hz) + " Hz)");
+                                       diagnostic_number(timer->achieved_hz) + " of " +
+                                       diagnostic_number(timer->configured_hz) + " Hz)");
       }
     }
     if (host.component) {

@@ -167,12 +167,34 @@ void ParameterService::Impl::create_endpoints() {
   }
 }
 
+namespace {
+
+/// The `clientid=...;` of an endpoint's USER_DATA: rmw_cyclonedds puts the same id on a
+/// client's request writer and its reply reader, so that a service answers only once the
+/// reader of *that* client has matched (one ros2 process holds several clients). Empty: none.
+std::string client_id(const dds_qos_t* qos) {
+  void* data = nullptr;
+  std::size_t size = 0;
+  if (qos == nullptr || !dds_qget_userdata(qos, &data, &size) || data == nullptr) return {};
+  const std::string text(static_cast<const char*>(data), size);
+  dds_free(data);
+  const std::string key = "clientid=";
+  const std::size_t at = text.find(key);
+  if (at == std::string::npos) return {};
+  const std::size_t end = text.find(';', at);
+  return text.substr(at + key.size(),
+                     end == std::string::npos ? std::string::npos : end - at - key.size());
+}
+
+}  // namespace
+
 bool ParameterService::Impl::reply_reader_matched(const Endpoint& endpoint,
                                                   dds_instance_handle_t publication) const {
   dds_builtintopic_endpoint_t* writer =
       dds_get_matched_publication_data(endpoint.reader->get(), publication);
   if (writer == nullptr) return true;  // the requester is gone or unknown: do not wait for it
-  dds_guid_t requester = writer->participant_key;
+  const dds_guid_t requester = writer->participant_key;
+  const std::string client = client_id(writer->qos);
   dds_builtintopic_free_endpoint(writer);
   constexpr std::size_t kMax = 256;
   dds_instance_handle_t readers[kMax];
@@ -181,7 +203,11 @@ bool ParameterService::Impl::reply_reader_matched(const Endpoint& endpoint,
     dds_builtintopic_endpoint_t* reader =
         dds_get_matched_subscription_data(endpoint.writer->get(), readers[i]);
     if (reader == nullptr) continue;
-    const bool same = std::memcmp(reader->participant_key.v, requester.v, sizeof requester.v) == 0;
+    // With a client id (ROS 2 clients): that client's reply reader; without (avs, plain DDS
+    // requesters): any reply reader of the requesting participant.
+    const bool same = client.empty() ? std::memcmp(reader->participant_key.v, requester.v,
+                                                   sizeof requester.v) == 0
+                                     : client_id(reader->qos) == client;
     dds_builtintopic_free_endpoint(reader);
     if (same) return true;
   }
@@ -312,7 +338,8 @@ void ParameterService::Impl::handle_set(Endpoint& ep, std::shared_ptr<void> samp
     const auto& req = *static_cast<const rcl::SetParameters_Request*>(sample.get());
     auto response = reply_to<rcl::SetParameters_Response>(req);
     for (const std::uint32_t i : changed_index) {
-      if (!refusal.empty()) (*reasons)[i] = ep.node->node_name() + " refused: " + refusal;
+      // The reply names the parameter's node already (`avs param set: /matching refused ...`).
+      if (!refusal.empty()) (*reasons)[i] = refusal;
     }
     resize_sequence(response->results, static_cast<std::uint32_t>(reasons->size()));
     for (std::size_t i = 0; i < reasons->size(); ++i) {

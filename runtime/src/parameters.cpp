@@ -159,17 +159,19 @@ std::string range_text(std::optional<double> min, std::optional<double> max) {
 }
 
 std::string to_string(ParamType type) {
+  // ROS 2's names (rcl_interfaces ParameterType, as `ros2 param describe` and `avs param`
+  // print them): one vocabulary in `avs components` and `avs param`.
   switch (type) {
     case ParamType::boolean:
-      return "bool";
+      return "boolean";
     case ParamType::integer:
       return "integer";
     case ParamType::real:
-      return "number";
+      return "double";
     case ParamType::string:
       return "string";
     case ParamType::real_list:
-      return "list of numbers";
+      return "double array";
   }
   return "unknown";
 }

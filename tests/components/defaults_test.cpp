@@ -30,6 +30,24 @@ TEST(ComponentDefaults, BoundParametersHaveTheirCoreConfigsDefaults) {
   }
 }
 
+// Issue 18: a parameter changed while the rig runs is checked against the spec's range before
+// it is applied; a live number or list of numbers without one (a gain set to -1, a torque
+// limit to 1e9) would go straight into the loop.
+TEST(ComponentDefaults, EveryLiveNumberHasARange) {
+  for (const RegisteredComponent* c : ComponentRegistry::instance().all()) {
+    if (c->spec.type.rfind("test_", 0) == 0) continue;  // test components
+    for (const ParamSpec& p : c->spec.parameters) {
+      if (!p.dynamic) continue;
+      if (p.type != ParamType::real && p.type != ParamType::integer &&
+          p.type != ParamType::real_list) {
+        continue;
+      }
+      EXPECT_TRUE(p.min.has_value() && p.max.has_value())
+          << c->spec.type << ": live parameter '" << p.name << "' has no range";
+    }
+  }
+}
+
 struct Sample {
   double gain = 2.5;
   float limit = 0.3F;

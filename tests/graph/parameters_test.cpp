@@ -55,7 +55,9 @@ TEST(ParamValue, ToStringAndTypeOf) {
   EXPECT_EQ(to_string(ParamValue{std::vector<double>{1.0, 2.5}}), "[1, 2.5]");
   EXPECT_EQ(type_of(ParamValue{std::vector<double>{}}), ParamType::real_list);
   EXPECT_EQ(type_of(ParamValue{std::int64_t{1}}), ParamType::integer);
-  EXPECT_EQ(to_string(ParamType::real), "number");
+  EXPECT_EQ(to_string(ParamType::real), "double");  // ROS 2's names, as avs param prints them
+  EXPECT_EQ(to_string(ParamType::real_list), "double array");
+  EXPECT_EQ(to_string(ParamType::boolean), "boolean");
 }
 
 TEST(ParamSpec, FactoriesStoreDefaults) {

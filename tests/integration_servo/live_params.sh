@@ -20,6 +20,8 @@ grep -q "max_torque_nm is not dynamic" "$out/param.txt" || { cat "$out/param.txt
 ! param set drive soft_upper_rad '[-5, 1.4]' || fail "an upper limit below the lower one was taken"
 grep -q "soft_lower_rad must be below soft_upper_rad" "$out/param.txt" ||
   { cat "$out/param.txt"; fail "no reason for the inconsistent limit"; }
+! param set drive brake_gain_nm_s_per_rad '[-1, 0.05]' || fail "a negative brake gain was taken"
+grep -q "in \[0, 1000\]" "$out/param.txt" || { cat "$out/param.txt"; fail "no range in the refusal"; }
 param get drive soft_upper_rad && grep -qx "\[0.2, 1.4\]" "$out/param.txt" ||
   { cat "$out/param.txt"; fail "the refused change altered the value in force"; }
 param set source step_at_s 0 || { cat "$out/param.txt" >&2; fail "could not start the step"; }

@@ -26,7 +26,9 @@ TEST(RosTypeName, MangleIsTheInverse) {
     EXPECT_EQ(dds_type_name(ros_type_name(name)), name);
   }
   EXPECT_EQ(dds_type_name("std_msgs/msg/Header"), "std_msgs::msg::dds_::Header_");
-  EXPECT_EQ(dds_type_name("std_msgs/Header"), "");
+  EXPECT_EQ(dds_type_name("std_msgs/Header"), "std_msgs::msg::dds_::Header_");  // ros2's short form
+  EXPECT_EQ(dds_type_name("std_msgs/"), "");
+  EXPECT_EQ(dds_type_name("/Header"), "");
   EXPECT_EQ(dds_type_name("a/b/c/d"), "");
   EXPECT_EQ(dds_type_name("/msg/X"), "");
 }

@@ -17,6 +17,8 @@
 
 #include "avs/msg/type_support.hpp"
 #include "avs/runtime/dds.hpp"
+#include "avs/runtime/parameter_messages.hpp"
+#include "avs/runtime/qos.hpp"
 #include "avs/runtime/ros_discovery.hpp"
 #include "avs/runtime/sample.hpp"
 #include "avs/testing/lockstep_graph.hpp"
@@ -71,6 +73,68 @@ std::vector<std::string> participant_user_data(const dds::Participant& participa
   }
   if (n > 0) dds_return_loan(reader.get(), samples, n);
   return out;
+}
+
+/// A reader or writer created the way rmw_cyclonedds creates a service client's endpoints:
+/// the service QoS and `clientid=ID;` in USER_DATA (the same ID on the client's request writer
+/// and reply reader).
+dds::Entity client_endpoint(const dds::Participant& participant, const dds::Topic& topic,
+                            bool writer, const std::string& id) {
+  Qos qos(service_qos());
+  const std::string user_data = "clientid=" + id + ";";
+  dds_qset_userdata(qos.get(), user_data.data(), user_data.size());
+  return dds::Entity(
+      check_dds(writer ? dds_create_writer(participant.get(), topic.get(), qos.get(), nullptr)
+                       : dds_create_reader(participant.get(), topic.get(), qos.get(), nullptr),
+                "client endpoint on " + topic.name()));
+}
+
+/// Issue 18 section 1, `ros2 param` against an avs node: one ROS 2 process holds several
+/// clients in one participant. A request from client A must not be answered as soon as some
+/// other client's reply reader of that participant has matched (the reply would go out before
+/// A's own reader exists and be lost to it): the service waits for the reader whose clientid
+/// is the request writer's, as rmw_cyclonedds's services do.
+TEST(RosNodes, ParameterReplyWaitsForTheReaderOfTheAskingClient) {
+  namespace rcl = msgs::rcl_interfaces;
+  avs::testing::BackgroundContainer graph(
+      {"{type: test_talker, name: talker, parameters: {rate_hz: 100}}"}, 600.0,
+      avs::testing::TestClock::wall);
+  for (const auto& e : graph.run().load_errors) ADD_FAILURE() << e;
+  ASSERT_NE(graph.run().container, nullptr);
+  dds::Participant participant(avs::testing::test_domain());
+  const QosProfile qos = service_qos();
+  dds::Topic requests(participant, msg::TypeSupport<rcl::GetParameters_Request>::descriptor(),
+                      parameter_request_topic("/talker", "get_parameters"), qos);
+  dds::Topic replies(participant, msg::TypeSupport<rcl::GetParameters_Response>::descriptor(),
+                     parameter_reply_topic("/talker", "get_parameters"), qos);
+  // Client B's reply reader, then client A's request writer; A's reader comes later.
+  const dds::Entity reader_b = client_endpoint(participant, replies, false, "0b.0b");
+  const dds::Entity writer_a = client_endpoint(participant, requests, true, "0a.0a");
+  for (const auto deadline = Clock::now() + std::chrono::seconds(20);;) {
+    dds_publication_matched_status_t matched{};
+    ASSERT_EQ(dds_get_publication_matched_status(writer_a.get(), &matched), DDS_RETCODE_OK);
+    if (matched.current_count > 0) break;
+    ASSERT_LT(Clock::now(), deadline) << "talker's get_parameters service never matched";
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  auto request = make_sample<rcl::GetParameters_Request>();
+  request->client_guid = 0xa;
+  request->sequence_number = 1;
+  ASSERT_EQ(dds_write(writer_a.get(), request.get()), DDS_RETCODE_OK);
+  // A moment for the service to take the request (a slow machine only makes this weaker).
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const dds::Entity reader_a = client_endpoint(participant, replies, false, "0a.0a");
+  bool answered = false;
+  for (const auto deadline = Clock::now() + std::chrono::seconds(20);
+       !answered && Clock::now() < deadline;) {
+    auto reply = make_sample<rcl::GetParameters_Response>();
+    void* buffers[1] = {reply.get()};
+    dds_sample_info_t info;
+    answered = dds_take(reader_a.get(), buffers, &info, 1, 1) > 0 && info.valid_data &&
+               reply->client_guid == 0xa && reply->sequence_number == 1;
+    if (!answered) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_TRUE(answered) << "client A's reader never got the reply to A's request";
 }
 
 TEST(RosNodes, EveryComponentIsOnRosDiscoveryInfoWithItsTopics) {

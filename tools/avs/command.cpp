@@ -26,6 +26,8 @@ CLI::Validator finite_number() {
 
 /// A bound as a person writes it: "232", "0.1", "3600" (this file links nothing of avs).
 std::string bound_text(double v) {
+  // Whole bounds as integers ("1000000000000000", not "1e+15"), as `avs components` prints.
+  if (std::floor(v) == v && std::abs(v) < 9.0e15) return std::to_string(static_cast<long long>(v));
   std::ostringstream out;
   out.precision(15);
   out << v;
@@ -171,7 +173,14 @@ Command* Command::own_help_flag(bool& value, std::string description) {
 }
 
 std::string Command::help_text() const {
-  return app_->help();
+  // With the parents' names, as CLI11's own --help prints it ("Usage: avs bench ..."); the
+  // program's own name is argv[0] (a path) or empty: "avs" as the docs write it.
+  std::string parents;
+  for (const CLI::App* a = app_->get_parent(); a != nullptr; a = a->get_parent()) {
+    const std::string name = a->get_parent() == nullptr ? "avs" : a->get_name();
+    parents = name + (parents.empty() ? "" : " " + parents);
+  }
+  return app_->help(parents);
 }
 
 std::size_t Command::count(const std::string& name) const {

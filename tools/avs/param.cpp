@@ -143,7 +143,8 @@ void run_dump(const ParamOptions& o) {
 
 void add_common(Command* cmd, ParamOptions& o, bool node_required, bool name, bool value) {
   add_domain_option(cmd, o.domain);
-  cmd->add_option("--timeout", o.timeout_s, "seconds to wait for the node and each answer")
+  cmd->add_option("--wait,--timeout", o.timeout_s,
+                  "seconds to wait for the node and each answer (--wait as in avs topic/node)")
       ->check_range(0.1, 3600)
       ->capture_default_str();
   auto* node = cmd->add_option("node", o.node,

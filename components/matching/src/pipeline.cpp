@@ -2,12 +2,20 @@
 
 #include <chrono>
 #include <filesystem>
+#include <sstream>
 #include <stdexcept>
 
 #include "avs/geometry/builtin_models.hpp"
 
 namespace avs::matching {
 namespace {
+
+/// "depth_min_m (2) must be below depth_max_m (1.5)": the numbers as written, not "2.000000".
+std::string depth_window_error(double min_m, double max_m) {
+  std::ostringstream out;
+  out << "depth_min_m (" << min_m << ") must be below depth_max_m (" << max_m << ")";
+  return out.str();
+}
 
 SceneCloudConfig scene_config(const PipelineConfig& config, const ModelCloud& model) {
   SceneCloudConfig scene = config.scene;
@@ -47,9 +55,8 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
       tracker_(model_, config_.tracker),
       scene_(&empty_) {
   if (!(config_.depth_min_m < config_.depth_max_m)) {
-    throw std::invalid_argument(
-        "MatchingPipeline: depth_min_m (" + std::to_string(config_.depth_min_m) +
-        ") must be below depth_max_m (" + std::to_string(config_.depth_max_m) + ")");
+    throw std::invalid_argument("MatchingPipeline: " +
+                                depth_window_error(config_.depth_min_m, config_.depth_max_m));
   }
   if (config_.lag_compensation_s < 0.0 || config_.velocity_window_s <= 0.0) {
     throw std::invalid_argument(
@@ -59,9 +66,7 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
 
 void MatchingPipeline::retune(const PipelineConfig& config) {
   if (!(config.depth_min_m < config.depth_max_m)) {
-    throw std::invalid_argument("depth_min_m (" + std::to_string(config.depth_min_m) +
-                                ") must be below depth_max_m (" +
-                                std::to_string(config.depth_max_m) + ")");
+    throw std::invalid_argument(depth_window_error(config.depth_min_m, config.depth_max_m));
   }
   if (config.lag_compensation_s < 0.0 || config.velocity_window_s <= 0.0) {
     throw std::invalid_argument("lag_compensation_s must be >= 0 and velocity_window_s > 0");

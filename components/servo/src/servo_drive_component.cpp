@@ -104,28 +104,31 @@ class ServoDrive final : public runtime::Component {
              // Per axis (pan, tilt): the head's safety rules, safety.hpp.
              per_axis("max_torque_nm", &AxisSafetyConfig::configured_max_torque_nm, "N m",
                       "configured motor torque limit per axis (also written to the drive's "
-                      "max_torque)"),
+                      "max_torque)",
+                      0.0, 100.0),
              per_axis("motor_max_torque_nm", &AxisSafetyConfig::motor_max_torque_nm, "N m",
-                      "motor peak torque per axis (Table 3)"),
+                      "motor peak torque per axis (Table 3)", 0.0, 100.0),
              per_axis("soft_lower_rad", &AxisSafetyConfig::soft_lower_rad, "rad",
-                      "soft lower position limit per axis")
+                      "soft lower position limit per axis", -1000.0, 1000.0)
                  .live(),
              per_axis("soft_upper_rad", &AxisSafetyConfig::soft_upper_rad, "rad",
-                      "soft upper position limit per axis")
+                      "soft upper position limit per axis", -1000.0, 1000.0)
                  .live(),
              ParamSpec::real("brake_zone_rad", any_axis.brake_zone_rad, 0.0, 10.0, "rad",
                              "braking zone inside each soft limit")
                  .live(),
              per_axis("brake_gain_nm_s_per_rad", &AxisSafetyConfig::brake_gain_nm_s_per_rad,
-                      "N m s/rad", "braking torque per output rad/s toward a nearby limit")
+                      "N m s/rad", "braking torque per output rad/s toward a nearby limit", 0.0,
+                      1000.0)
                  .live(),
              per_axis("output_inertia_kg_m2", &AxisSafetyConfig::output_inertia_kg_m2, "kg m2",
                       "output-side inertia J_eq per axis, for the soft-limit velocity envelope "
-                      "(0 = no envelope)"),
+                      "(0 = no envelope)",
+                      0.0, 1000.0),
              per_axis("gear_ratio", &AxisSafetyConfig::gear_ratio, "",
-                      "motor turns per output turn, per axis (envelope)"),
+                      "motor turns per output turn, per axis (envelope)", 0.001, 100000.0),
              per_axis("gear_efficiency", &AxisSafetyConfig::gear_efficiency, "",
-                      "gear efficiency per axis (envelope)"),
+                      "gear efficiency per axis (envelope)", 0.01, 1.0),
              ParamSpec::real("envelope_brake_fraction", any_axis.envelope_brake_fraction, 0.0, 1.0,
                              "",
                              "share of the full braking deceleration the velocity envelope "
@@ -213,10 +216,13 @@ class ServoDrive final : public runtime::Component {
 
   /// A per-axis list parameter whose default is the field of the pan and the tilt axis.
   static ParamSpec per_axis(std::string name, double AxisSafetyConfig::*field, std::string unit,
-                            std::string description) {
-    return ParamSpec::real_list(std::move(name),
-                                {pan_safety_config().*field, tilt_safety_config().*field},
-                                std::move(unit), std::move(description));
+                            std::string description, double min, double max) {
+    ParamSpec spec = ParamSpec::real_list(std::move(name),
+                                          {pan_safety_config().*field, tilt_safety_config().*field},
+                                          std::move(unit), std::move(description));
+    spec.min = min;  // each element
+    spec.max = max;
+    return spec;
   }
 
   explicit ServoDrive(ComponentContext& ctx)

@@ -84,16 +84,16 @@ class TrackingComponent final : public runtime::Component {
             .real("a_m", AVS_FIELD(tracker.law.a_m), -1.0, 1.0, "m",
                   "Figure 3: tilt axis to camera centre along X_c (full Jacobian)")
             .vector("kp_nm_per_rad", AVS_FIELD(tracker.law.kp_nm_per_rad), "N m/rad",
-                    "K_p (pan, tilt); tuned on servo_tracking_loop.yaml")
+                    "K_p (pan, tilt); tuned on servo_tracking_loop.yaml", 0.0, 1000.0)
             .live()
             .vector("kv_nm_s_per_rad", AVS_FIELD(tracker.law.kv_nm_s_per_rad), "N m s/rad",
-                    "K_v (pan, tilt); tuned on servo_tracking_loop.yaml")
+                    "K_v (pan, tilt); tuned on servo_tracking_loop.yaml", 0.0, 1000.0)
             .live()
             .vector("m_d_px", AVS_FIELD(tracker.law.m_d_px), "px",
-                    "desired image position relative to the principal point")
+                    "desired image position relative to the principal point", -100000.0, 100000.0)
             .live()
             .vector("max_torque_nm", AVS_FIELD(tracker.law.max_torque_nm), "N m",
-                    "motor torque limit per axis (Table 3)")
+                    "motor torque limit per axis (Table 3)", 0.0, 100.0)
             .live()
             .real("min_cos_q2", AVS_FIELD(tracker.law.min_cos_q2), 0.001, 1.0, "",
                   "|cos q2| floor that keeps J invertible")
@@ -108,13 +108,14 @@ class TrackingComponent final : public runtime::Component {
                         {"hold", IdleBehaviour::hold}, {"return_home", IdleBehaviour::return_home}},
                     "idle behaviour")
             .live()
-            .vector("home_q_rad", AVS_FIELD(tracker.home_q_rad), "rad", "home pose (return_home)")
+            .vector("home_q_rad", AVS_FIELD(tracker.home_q_rad), "rad", "home pose (return_home)",
+                    -7.0, 7.0)
             .live()
             .vector("hold_kp_nm_per_rad", AVS_FIELD(tracker.hold_kp_nm_per_rad), "N m/rad",
-                    "joint PD for hold / home")
+                    "joint PD for hold / home", 0.0, 1000.0)
             .live()
             .vector("hold_kv_nm_s_per_rad", AVS_FIELD(tracker.hold_kv_nm_s_per_rad), "N m s/rad",
-                    "joint PD for hold / home")
+                    "joint PD for hold / home", 0.0, 1000.0)
             .live();
     return p;
   }

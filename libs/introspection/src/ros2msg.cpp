@@ -94,6 +94,11 @@ std::string ros_type_name(std::string_view dds_name) {
 std::string dds_type_name(std::string_view ros_name) {
   const auto first = ros_name.find('/');
   const auto last = ros_name.rfind('/');
+  if (first != std::string_view::npos && first > 0 && last == first && last + 1 < ros_name.size()) {
+    // "std_msgs/Bool": the short form `ros2 topic pub` takes, a message type.
+    return std::string(ros_name.substr(0, first)) +
+           "::msg::dds_::" + std::string(ros_name.substr(last + 1)) + "_";
+  }
   if (first == std::string_view::npos || first == 0 || last == first ||
       last + 1 == ros_name.size() || ros_name.find('/', first + 1) != last) {
     return "";

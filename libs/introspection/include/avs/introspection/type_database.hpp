@@ -116,7 +116,9 @@ const TypeDatabase& built_in_types();
 std::string ros_type_name(std::string_view dds_name);
 
 /// The inverse, as rmw_cyclonedds mangles ROS names: "sensor_msgs/msg/Image" ->
-/// "sensor_msgs::msg::dds_::Image_". Returns "" for a name that is not "pkg/ns/Type".
+/// "sensor_msgs::msg::dds_::Image_"; the short form "sensor_msgs/Image" (as `ros2 topic pub`
+/// takes it) is a message type. Returns "" for a name that is neither "pkg/ns/Type" nor
+/// "pkg/Type".
 std::string dds_type_name(std::string_view ros_type_name);
 
 /// The complete `ros2msg` definition as rosbag2 stores it in MCAP Schema records: the root
