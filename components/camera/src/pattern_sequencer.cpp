@@ -378,11 +378,16 @@ void PatternSequencer::locked_push(const CameraFrame& frame, Released& out) {
   if (config_.verify_pairs && difference < 0) {
     // Nothing to check it against (every pair since the last checked one lost in gaps for
     // longer than the bridge, found by fuzz_pattern_sequencer with a slip after them; or too
-    // few lit pixels): not labelled, its sum is the reference for the next pair.
+    // few lit pixels): not labelled, and the lock is dropped. Its sum must not become the
+    // reference for the next pair: a camera that slipped an exposure inside those gaps makes
+    // it a misaligned couple, and the next misaligned couple matched it and was labelled one
+    // exposure off (fuzz_pattern_sequencer, 2026-12-06: 8 gaps of 16 frames after a slip).
+    // Hunting finds the structure again from the images.
     ++stats_.unverified_pairs;
     out.add(release(*held_, DropReason::kUnverified));
     held_.reset();
     out.add(release(frame, DropReason::kUnverified));
+    lose_lock(out);
     return;
   }
   if (difference > config_.pair_sum_match_max) {

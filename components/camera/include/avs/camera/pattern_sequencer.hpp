@@ -89,7 +89,8 @@ enum class DropReason : std::uint8_t {
   kLate,          ///< an older id than the last, its timestamp as much older (completed late)
   kUnpaired,      ///< its pair partner was lost (a lone frame cannot be verified or decoded)
   kVerifyFailed,  ///< the pair's structure did not match: lock dropped
-  kUnverified,    ///< no earlier pair to check the pair against (long gaps, dark): not labelled
+  kUnverified,    ///< no earlier pair to check the pair against (long gaps, dark): not
+                  ///< labelled, and the lock is dropped (hunting again)
   kFlushed,       ///< still held at flush()
 };
 
@@ -118,7 +119,8 @@ struct SequencerStats {
   std::int64_t late_frames = 0;  ///< older ids arriving after newer ones; dropped
   std::int64_t dropped_unpaired = 0;
   std::int64_t verify_failures = 0;   ///< pairs whose structure did not match (lock dropped)
-  std::int64_t unverified_pairs = 0;  ///< pairs with nothing to check them against: dropped
+  std::int64_t unverified_pairs = 0;  ///< pairs with nothing to check them against: dropped,
+                                      ///< and the lock with them
   std::int64_t missing_ids = 0;       ///< ids skipped by forward gaps
   std::int64_t gaps = 0;          ///< discontinuities of any kind (id skips, time steps, restarts)
   std::int64_t bridged_gaps = 0;  ///< gaps crossed while staying locked
