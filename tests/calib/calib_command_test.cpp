@@ -45,6 +45,9 @@ TEST(CalibCommand, CaptureThenSolveWritesALoadableCalibration) {
   EXPECT_EQ(g.layout.code_count, truth.layout.code_count);
   EXPECT_TRUE(fs::exists(dir / "out" / "calibration_report" / "coverage_camera.png"));
   EXPECT_TRUE(fs::exists(dir / "out" / "calibration_report" / "view_errors.csv"));
+  EXPECT_NE(avs::testing::read_file(dir / "out" / "calibration_report" / "corner_errors.csv")
+                .find("view,corner,camera_x_px"),
+            std::string::npos);
 
   // The same capture with a stricter rule is refused, with the reason, and writes nothing.
   const fs::path refused = dir / "refused.yaml";

@@ -177,13 +177,14 @@ int run_solve(const SolveOptions& o) {
     views << v.name << ',' << (v.used ? 1 : 0) << ',' << v.corners << ',' << v.camera_rms_px << ','
           << v.projector_rms_px << ",\"" << v.why_not << "\"\n";
   }
+  std::ofstream(report / "corner_errors.csv") << calib::corner_errors_csv(result);
   if (result.views_used > 0) {
     decode::write_png_gray8((report / "coverage_camera.png").string(),
                             calib::coverage_image(index.info, observations, result, false));
     decode::write_png_gray8((report / "coverage_projector.png").string(),
                             calib::coverage_image(index.info, observations, result, true));
   }
-  std::printf("report (summary.txt, view_errors.csv, coverage_*.png) in %s\n",
+  std::printf("report (summary.txt, view_errors.csv, corner_errors.csv, coverage_*.png) in %s\n",
               report.string().c_str());
   if (!result.accepted) {
     std::cerr << "avs calib solve: calibration refused, " << o.out << " not written:\n";

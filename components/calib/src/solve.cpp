@@ -58,6 +58,7 @@ CalibrationResult solve_calibration(const CaptureInfo& info,
   std::vector<Eigen::Vector2d> all_camera, all_projector;
   long found_corners = 0, undecoded_corners = 0;
   std::vector<std::size_t> used_index;
+  std::vector<std::vector<const CornerObservation*>> used_corners;  ///< per used view
   for (std::size_t v = 0; v < views.size(); ++v) {
     const ViewObservation& view = views[v];
     ViewReport report;
@@ -81,9 +82,11 @@ CalibrationResult solve_calibration(const CaptureInfo& info,
       report.used = true;
       std::vector<cv::Point3f> object;
       std::vector<cv::Point2f> camera, projector;
+      std::vector<const CornerObservation*> observed;
       const int nx = info.board.inner_corners_x();
       for (const CornerObservation& c : view.corners) {
         if (!c.has_projector) continue;
+        observed.push_back(&c);
         const Eigen::Vector3d p = info.board.corner_board_m(c.index % nx, c.index / nx);
         object.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), 0.0f);
         camera.emplace_back(static_cast<float>(c.camera_px.x()),
@@ -98,6 +101,7 @@ CalibrationResult solve_calibration(const CaptureInfo& info,
       camera_points.push_back(std::move(camera));
       projector_points.push_back(std::move(projector));
       used_index.push_back(v);
+      used_corners.push_back(std::move(observed));
     }
     result.views.push_back(report);
   }
@@ -170,6 +174,34 @@ CalibrationResult solve_calibration(const CaptureInfo& info,
     projector_sum2 += report.projector_rms_px * report.projector_rms_px * report.corners;
     points += report.corners;
   }
+  // 5b. Per corner, through the final model (CornerError): the board pose from the view's
+  // camera corners, the projector through the solved R, T.
+  for (std::size_t u = 0; u < used_index.size(); ++u) {
+    cv::Mat rvec, tvec;
+    if (!cv::solvePnP(object_points[u], camera_points[u], Kc, Dc, rvec, tvec)) continue;
+    cv::Mat R_board;
+    cv::Rodrigues(rvec, R_board);
+    cv::Mat R_projector_board = R * R_board, rvec_projector;
+    cv::Rodrigues(R_projector_board, rvec_projector);
+    const cv::Mat tvec_projector = R * tvec + T;
+    std::vector<cv::Point2f> at_camera, at_projector;
+    cv::projectPoints(object_points[u], rvec, tvec, Kc, Dc, at_camera);
+    cv::projectPoints(object_points[u], rvec_projector, tvec_projector, Kp, Dp, at_projector);
+    for (std::size_t k = 0; k < object_points[u].size(); ++k) {
+      const CornerObservation& c = *used_corners[u][k];
+      CornerError e;
+      e.view = views[used_index[u]].name;
+      e.index = c.index;
+      e.camera_px = c.camera_px;
+      e.projector_px = c.projector_px;
+      e.camera_residual_px = c.camera_px - Eigen::Vector2d(at_camera[k].x, at_camera[k].y);
+      e.projector_residual_px =
+          c.projector_px - Eigen::Vector2d(at_projector[k].x, at_projector[k].y);
+      e.window_fraction = c.window_fraction;
+      e.homography_rms_px = c.homography_rms_px;
+      result.corners.push_back(e);
+    }
+  }
   result.camera_rms_px = std::sqrt(camera_sum2 / static_cast<double>(points));
   result.projector_rms_px = std::sqrt(projector_sum2 / static_cast<double>(points));
   if (!(result.camera_rms_px <= config.max_camera_rms_px)) {
@@ -217,6 +249,22 @@ decode::GrayImage8 coverage_image(const CaptureInfo& info,
     }
   }
   return image;
+}
+
+std::string corner_errors_csv(const CalibrationResult& r) {
+  std::ostringstream out;
+  out << "view,corner,camera_x_px,camera_y_px,camera_dx_px,camera_dy_px,projector_x_px,"
+         "projector_y_px,projector_dx_px,projector_dy_px,window_fraction,homography_rms_px\n";
+  char line[512];
+  for (const CornerError& e : r.corners) {
+    std::snprintf(line, sizeof line, "%s,%d,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.4f\n",
+                  e.view.c_str(), e.index, e.camera_px.x(), e.camera_px.y(),
+                  e.camera_residual_px.x(), e.camera_residual_px.y(), e.projector_px.x(),
+                  e.projector_px.y(), e.projector_residual_px.x(), e.projector_residual_px.y(),
+                  e.window_fraction, e.homography_rms_px);
+    out << line;
+  }
+  return out.str();
 }
 
 std::string summary_text(const CalibrationResult& r) {

@@ -43,6 +43,21 @@ struct ViewReport {
   double projector_rms_px = 0;
 };
 
+/// One used corner's reprojection through the final model: the board pose fitted to the
+/// view's camera corners with the final camera lens (solvePnP), the projector through the
+/// solved R, t. Residual = observed - predicted; a corner whose projector residual stands out
+/// from its view's had an unstable decode (its window_fraction, homography_rms_px say why).
+struct CornerError {
+  std::string view;
+  int index = 0;  ///< row-major inner-corner index
+  Eigen::Vector2d camera_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d camera_residual_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d projector_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d projector_residual_px = Eigen::Vector2d::Zero();
+  double window_fraction = 0;    ///< decode confidence (CornerObservation)
+  double homography_rms_px = 0;  ///< decode confidence (CornerObservation)
+};
+
 struct CalibrationResult {
   /// True when every check passed; otherwise `refusals` says why (and geometry, if a solve
   /// was possible, is still filled for inspection, but must not be used).
@@ -57,6 +72,7 @@ struct CalibrationResult {
   double undecoded_fraction = 0;
   int views_used = 0;
   std::vector<ViewReport> views;
+  std::vector<CornerError> corners;  ///< every used corner, when a solve was possible
 };
 
 /// Calibrates from the observations; never throws for bad data (it refuses instead).
@@ -69,6 +85,10 @@ CalibrationResult solve_calibration(const CaptureInfo& info,
 decode::GrayImage8 coverage_image(const CaptureInfo& info,
                                   const std::vector<ViewObservation>& views,
                                   const CalibrationResult& result, bool projector);
+
+/// The per-corner errors as CSV (`corner_errors.csv` of `avs calib solve`'s report): a header
+/// line, then one line per used corner.
+std::string corner_errors_csv(const CalibrationResult& result);
 
 /// A short text summary (per-view errors, figures, refusals).
 std::string summary_text(const CalibrationResult& result);
