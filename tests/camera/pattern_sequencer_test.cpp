@@ -308,6 +308,29 @@ TEST(PatternSequencer, SlipRightAfterABridgedGapIsCaughtToo) {
   EXPECT_EQ(o.stats.locks, 2);
 }
 
+TEST(PatternSequencer, FramesBeforeTheLastRestartAreNeverTakenForLateFrames) {
+  // Found by fuzz_pattern_sequencer: the camera restarts with ids from 8 (its clock as if from
+  // id 1), locks, then restarts again from id 1 with the same clock origin. Ids 1..6 fit
+  // places inside the first restart's advance, never ids of this stream: they were taken for
+  // frames completed late, the lock stayed, and the next ids (41 on, continuing the first
+  // numbering) were labelled 6 frames off: 3 whole pairs, which pair sums cannot see.
+  const std::int64_t ms = 1'000'000;
+  std::vector<Delivery> s = stream(0, 40);
+  std::int64_t f = 40;
+  for (std::uint64_t id = 8; id <= 40; ++id)
+    s.push_back({f++, id, static_cast<std::int64_t>(id - 1) * ms});
+  for (std::uint64_t id = 1; id <= 6; ++id)
+    s.push_back({f++, id, static_cast<std::int64_t>(id - 1) * ms});
+  for (std::uint64_t id = 41; id <= 41 + 8 * kFramesPerCycle; ++id) {
+    s.push_back({f++, id, static_cast<std::int64_t>(id - 1) * ms});
+  }
+  const Outcome o = run(s);
+  expect_true_labels(o);
+  EXPECT_EQ(o.stats.late_frames, 0);
+  EXPECT_GE(o.stats.restarts, 2);
+  EXPECT_GT(o.labelled, 2 * kFramesPerCycle);
+}
+
 TEST(PatternSequencer, RestartSoonAfterStartIsNotTakenForLateFrames) {
   // Found by fuzz_pattern_sequencer: the camera restarts 100 frames after it started, its ids
   // from 1 and its clock from the same origin again. The new ids looked like frames completed

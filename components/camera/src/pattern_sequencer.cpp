@@ -80,6 +80,7 @@ Released PatternSequencer::push(const CameraFrame& frame) {
     last_id_ = frame.frame_id;
     last_timestamp_ns_ = frame.timestamp_ns;
     position_ = 0;
+    stream_start_position_ = 0;
     note_received();
     hunt(frame, false, out);
     return out;
@@ -101,8 +102,14 @@ Released PatternSequencer::push(const CameraFrame& frame) {
   // with a timestamp that fits its old place, is a camera that restarted its ids and its clock
   // soon after it started (found by fuzz_pattern_sequencer: taken as late frames, the new ids
   // then continued the old ones, shifted by a restart's worth of exposures): a restart below.
+  // Its place must also lie after the last discontinuity: a place before it (inside the
+  // advance past a restart or an unbridged gap) was never an id of this stream. A camera that
+  // restarted twice, the second time with ids and a clock that fitted places inside the first
+  // restart's advance, was taken for late frames, the lock kept, and its next frames continued
+  // the old ids 23 exposures off: labelled a whole pair off, which pair sums cannot see
+  // (fuzz_pattern_sequencer, 2026-12-06).
   if (step < 0 && consistent && -step <= config_.max_bridged_gap_frames &&
-      !was_received(position_ + step)) {
+      position_ + step >= stream_start_position_ && !was_received(position_ + step)) {
     ++stats_.late_frames;  // completed after newer frames: nothing to relabel
     mark_received(position_ + step);
     out.add(release(frame, DropReason::kLate));
@@ -116,6 +123,7 @@ Released PatternSequencer::push(const CameraFrame& frame) {
     // Not adjacent to anything before (no pair across a restart), and no earlier id's place
     // is taken for one of the new ids.
     position_ += config_.max_bridged_gap_frames + 2;
+    stream_start_position_ = position_;
     note_received();
     lose_lock(out);
     hunt(frame, false, out);
@@ -130,7 +138,12 @@ Released PatternSequencer::push(const CameraFrame& frame) {
   // Past a gap that cannot be bridged only "not adjacent" matters (no pair across it): a
   // bounded advance keeps position_ from overflowing on ids or clocks that jump far.
   const std::int64_t bridge = config_.max_bridged_gap_frames;
-  position_ += consistent && step <= bridge ? step : bridge + 2;
+  if (consistent && step <= bridge) {
+    position_ += step;
+  } else {
+    position_ += bridge + 2;
+    stream_start_position_ = position_;  // no late frame from before an unbridged gap
+  }
   note_received();
   if (locked_) {
     if (consistent && step <= config_.max_bridged_gap_frames) {

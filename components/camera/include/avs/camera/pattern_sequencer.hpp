@@ -179,6 +179,9 @@ class PatternSequencer {
   std::uint64_t last_id_ = 0;
   std::int64_t last_timestamp_ns_ = 0;
   std::int64_t position_ = 0;  ///< unwrapped frame count of the last frame
+  /// position_ of the first frame after the last restart or unbridged gap: a late frame's
+  /// place must not be before it.
+  std::int64_t stream_start_position_ = 0;
   /// The positions received, by position modulo max_bridged_gap_frames + 1 (-1: none): a frame
   /// with an older id is late only if nothing was received at its place.
   std::vector<std::int64_t> received_;
