@@ -4,8 +4,10 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -87,6 +89,57 @@ TEST(CalibCommand, BenchJsonHasTheIssueKeys) {
   }
   fs::remove(out.string() + ".json");
   fs::remove(out.string() + ".err");
+}
+
+// Issue 14 section 4: the closed loop (`avs experiments ken`) decoding with a calibration that
+// `avs calib solve` recovered from a simulated capture does as well as decoding with the true
+// one, the simulator rendering with the truth (docs/calibration.md: the bench's sensor, whose
+// truth itself misses the 2 deg orientation goal, so that goal is compared, not asserted).
+TEST(CalibCommand, ClosedLoopWithTheRecoveredCalibrationDoesAsWellAsWithTheTruth) {
+  const fs::path dir = fs::temp_directory_path() / ("avs-calib-loop-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log = dir / "log.txt", err = dir / "err.txt";
+  ASSERT_EQ(avs::testing::run_avs({"calib", "capture", "--generate", "16", "--near", "0.55",
+                                   "--far", "1.6", "--out", (dir / "capture").string()},
+                                  log, err),
+            0)
+      << avs::testing::read_file(err);
+  const fs::path truth = dir / "capture" / "truth_calibration.yaml";
+  const fs::path recovered = dir / "recovered.yaml";
+  ASSERT_EQ(
+      avs::testing::run_avs(
+          {"calib", "solve", (dir / "capture").string(), "--out", recovered.string()}, log, err),
+      0)
+      << avs::testing::read_file(log) << avs::testing::read_file(err);
+  const auto run_ken = [&](const std::vector<std::string>& calibration, const char* name) {
+    std::vector<std::string> words = {"experiments", "ken", "--json", "--out",
+                                      (dir / name).string()};
+    words.insert(words.end(), calibration.begin(), calibration.end());
+    const fs::path json = dir / (std::string(name) + ".json");
+    EXPECT_EQ(avs::testing::run_avs(words, json, err), 0) << avs::testing::read_file(err);
+    return avs::testing::read_file(json);
+  };
+  const std::string with_truth = run_ken({"--calibration", truth.string()}, "truth");
+  const std::string with_recovered = run_ken(
+      {"--true-calibration", truth.string(), "--calibration", recovered.string()}, "recovered");
+  const auto value = [](const std::string& json, const char* key) {
+    return avs::testing::json_number(json, key);
+  };
+  const double truth_mm = value(with_truth, "position_error_mm_rms");
+  const double truth_deg = value(with_truth, "orientation_error_deg_rms");
+  const double recovered_mm = value(with_recovered, "position_error_mm_rms");
+  const double recovered_deg = value(with_recovered, "orientation_error_deg_rms");
+  std::printf(
+      "ken, decoded with the true calibration: %.2f mm / %.2f deg, %g flips; with the "
+      "recovered one: %.2f mm / %.2f deg, %g flips\n",
+      truth_mm, truth_deg, value(with_truth, "flips"), recovered_mm, recovered_deg,
+      value(with_recovered, "flips"));
+  EXPECT_EQ(value(with_recovered, "flips"), 0);
+  EXPECT_LE(recovered_mm, 3.0);
+  EXPECT_NEAR(recovered_mm, truth_mm, 0.3);
+  EXPECT_NEAR(recovered_deg, truth_deg, 0.15);
+  fs::remove_all(dir);
 }
 
 }  // namespace
