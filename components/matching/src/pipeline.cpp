@@ -10,11 +10,18 @@
 namespace avs::matching {
 namespace {
 
-/// "depth_min_m (2) must be below depth_max_m (1.5)": the numbers as written, not "2.000000".
-std::string depth_window_error(double min_m, double max_m) {
-  std::ostringstream out;
-  out << "depth_min_m (" << min_m << ") must be below depth_max_m (" << max_m << ")";
-  return out.str();
+/// The settings the constructor and retune() both refuse: an empty depth window ("depth_min_m
+/// (2) must be below depth_max_m (1.5)", the numbers as written) or lag settings out of range.
+void check_settings(const PipelineConfig& config, const std::string& who) {
+  if (!(config.depth_min_m < config.depth_max_m)) {
+    std::ostringstream out;
+    out << who << "depth_min_m (" << config.depth_min_m << ") must be below depth_max_m ("
+        << config.depth_max_m << ")";
+    throw std::invalid_argument(out.str());
+  }
+  if (config.lag_compensation_s < 0.0 || config.velocity_window_s <= 0.0) {
+    throw std::invalid_argument(who + "lag_compensation_s must be >= 0 and velocity_window_s > 0");
+  }
 }
 
 SceneCloudConfig scene_config(const PipelineConfig& config, const ModelCloud& model) {
@@ -54,23 +61,11 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
       builder_(scene_config(config_, model_)),
       tracker_(model_, config_.tracker),
       scene_(&empty_) {
-  if (!(config_.depth_min_m < config_.depth_max_m)) {
-    throw std::invalid_argument("MatchingPipeline: " +
-                                depth_window_error(config_.depth_min_m, config_.depth_max_m));
-  }
-  if (config_.lag_compensation_s < 0.0 || config_.velocity_window_s <= 0.0) {
-    throw std::invalid_argument(
-        "MatchingPipeline: lag_compensation_s must be >= 0 and velocity_window_s > 0");
-  }
+  check_settings(config_, "MatchingPipeline: ");
 }
 
 void MatchingPipeline::retune(const PipelineConfig& config) {
-  if (!(config.depth_min_m < config.depth_max_m)) {
-    throw std::invalid_argument(depth_window_error(config.depth_min_m, config.depth_max_m));
-  }
-  if (config.lag_compensation_s < 0.0 || config.velocity_window_s <= 0.0) {
-    throw std::invalid_argument("lag_compensation_s must be >= 0 and velocity_window_s > 0");
-  }
+  check_settings(config, "");
   config_.depth_min_m = config.depth_min_m;
   config_.depth_max_m = config.depth_max_m;
   builder_.set_depth_window(config.depth_min_m, config.depth_max_m);
