@@ -12,6 +12,7 @@
 #include "avs/decode/gray_code.hpp"
 #include "avs/geometry/primitives.hpp"
 #include "avs/sim/renderer.hpp"
+#include "facing_plane.hpp"
 
 namespace avs::sim {
 namespace {
@@ -19,13 +20,9 @@ namespace {
 constexpr double kPlaneDistanceM = 0.9;
 
 /// A large plane facing the camera at z = distance (camera frame).
+using test::facing_plane;
 RenderObject plane_at(const geometry::Mesh& mesh, double distance_m, double albedo = 0.6) {
-  RenderObject o;
-  o.mesh = &mesh;
-  o.T_camera_object = Eigen::Translation3d(0, 0, distance_m) *
-                      Eigen::AngleAxisd(std::numbers::pi, Eigen::Vector3d::UnitX());  // faces -z
-  o.albedo = albedo;
-  return o;
+  return facing_plane(mesh, distance_m, albedo);
 }
 
 /// Slab test: does the segment a -> b cross the axis-aligned box [lo, hi]?

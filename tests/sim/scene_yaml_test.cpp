@@ -75,6 +75,28 @@ objects:
   EXPECT_EQ(file.scene.objects[3].mesh->triangles.size(), 2u);
 }
 
+TEST(SceneYaml, SensorProfileThenSingleEffectOverrides) {
+  const SceneFile file = parse_scene(R"(
+sensor:
+  profile: realistic
+  camera: {gamma: 2.2}
+  projector: {black_level: 0.01}
+objects:
+  - {name: ken, model: ken}
+)",
+                                     "test.yaml", ".", models());
+  const SensorEffects& e = file.config.renderer.effects;
+  EXPECT_DOUBLE_EQ(e.camera.gamma, 2.2);
+  EXPECT_DOUBLE_EQ(e.projector.black_level, 0.01);
+  EXPECT_GT(e.camera.full_well_e, 0) << "the rest of the realistic profile stays";
+  EXPECT_GT(e.projector.aperture_m, 0);
+  EXPECT_GT(file.config.motion_blur_samples, 1);
+  EXPECT_NE(error_of("sensor:\n  profile: sharp\n").find("test.yaml:2:"), std::string::npos);
+  EXPECT_NE(error_of("sensor:\n  profile: sharp\n").find("ideal or realistic"), std::string::npos);
+  EXPECT_NE(error_of("sensor:\n  camera: {gamma: -1}\n").find("gamma must be > 0"),
+            std::string::npos);
+}
+
 TEST(SceneYaml, ErrorsNameFileLineAndColumn) {
   EXPECT_NE(error_of("objects:\n  - name: a\n    model: ken\n    trajectory: {type: spiral}\n")
                 .find("test.yaml:4:"),

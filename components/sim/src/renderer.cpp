@@ -155,6 +155,7 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
     }
   }
   noise_bank_ = make_noise_bank(config_.noise_seed);
+  set_up_effects(pinhole);
   R_projector_camera_ = g.R_projector_camera.cast<float>();
   t_projector_camera_m_ = g.t_projector_camera_m.cast<float>();
   projector_centre_camera_m_ = g.projector_centre_camera_m().cast<float>();
@@ -191,6 +192,97 @@ Renderer::Renderer(RendererConfig config) : config_(std::move(config)) {
   shadow_cell_u_.assign(pixels, -1);
   shadow_cell_v_.assign(pixels, -1);
   truth_.valid = true;  // nothing in view yet
+}
+
+void Renderer::set_up_effects(const geometry::CameraModel& pinhole) {
+  const SensorEffects& e = config_.effects;
+  if (const std::string problem = e.problem(); !problem.empty()) {
+    throw std::invalid_argument("sim::Renderer: sensor effects: " + problem);
+  }
+  pattern_effects_ = e.changes_pattern_light();
+  if (pattern_effects_ && calibration_patterns_) {
+    throw std::invalid_argument(
+        "sim::Renderer: projector defocus, black level, specular and texture effects are "
+        "rendered for the row codes only, not with calibration patterns (column_layout)");
+  }
+  const std::size_t pixels = static_cast<std::size_t>(pinhole.width) * pinhole.height;
+  if (e.projector.blurs()) {
+    code_position_.assign(pixels, 0.0f);
+    inv_blur_codes_.assign(pixels, 0.0f);
+    phi_table_.resize(512);
+    for (std::size_t k = 0; k < phi_table_.size(); ++k) {
+      const double z = (static_cast<double>(k) + 0.5) / 128.0;
+      phi_table_[k] = static_cast<float>(0.5 * std::erfc(-z / std::numbers::sqrt2));
+    }
+  }
+  camera_response_ = !e.camera.is_ideal();
+  if (!camera_response_) return;
+  const CameraResponse& c = e.camera;
+  const std::size_t camera_pixels =
+      static_cast<std::size_t>(config_.geometry.camera.width) * config_.geometry.camera.height;
+  // The fixed pattern: drawn once from the noise seed (another stream than the frames' noise).
+  const std::vector<std::int8_t> fixed = make_noise_bank(config_.noise_seed ^ 0xF1C5D0A7ull);
+  prnu_gain_.resize(camera_pixels);
+  dsnu_dn_.resize(camera_pixels);
+  for (std::size_t i = 0; i < camera_pixels; ++i) {
+    prnu_gain_[i] = 1.0f + static_cast<float>(c.prnu_fraction) * fixed[2 * i] / kNoiseBankScale;
+    dsnu_dn_[i] = static_cast<float>(c.dsnu_dn) * fixed[2 * i + 1] / kNoiseBankScale;
+  }
+  dn_per_electron_ = c.full_well_e > 0 ? kFullScaleDn / static_cast<float>(c.full_well_e) : 0.0f;
+  const float read_dn = static_cast<float>(c.read_noise_e) * dn_per_electron_;
+  read_variance_dn2_ = read_dn * read_dn;
+  if (c.gamma != 1.0) {
+    gamma_table_.resize(1025);
+    for (std::size_t k = 0; k < gamma_table_.size(); ++k) {
+      const double signal = std::min(static_cast<double>(k) / 4.0, 255.0) / 255.0;
+      gamma_table_[k] = static_cast<float>(255.0 * std::pow(signal, 1.0 / c.gamma));
+    }
+  }
+}
+
+/// Light of one row bit at a pinhole pixel as a fraction of the projector's (see
+/// Renderer::row_bit_light). Defocus blurs each stripe edge by a Gaussian: the nearest edge of
+/// the bit decides (the stripes of bit k are 2^(n-k) codes wide, the blur at most a few DMD
+/// rows), so the light is Phi(distance / sigma) on the pixel's own side of it.
+struct Renderer::RowBitLight {
+  const std::uint16_t* gray;
+  unsigned shift, flip;
+  float black, swing;          ///< light = black + swing x bit
+  const float* code_position;  ///< null: sharp stripes
+  const float* inv_blur;
+  const float* phi;
+  float period, first_edge;  ///< of this bit's edges, in codes: first_edge + m period
+
+  float operator()(std::size_t i) const {
+    const auto g = static_cast<unsigned>(gray[i]);
+    // Uncoded pixels (no kCoded flag) are dark in both polarities.
+    const unsigned bit = (((g >> shift) & 1u) ^ flip) & (g >> 15);
+    if (code_position == nullptr || (g >> 15) == 0) return black + swing * static_cast<float>(bit);
+    float t = code_position[i] - first_edge;
+    t -= period * std::floor(t / period);
+    const float distance = std::min(t, period - t) * inv_blur[i];  // in sigmas
+    const int k = static_cast<int>(distance * 128.0f);
+    const float same_side = k < 512 ? phi[k] : 1.0f;
+    return black + swing * (bit ? same_side : 1.0f - same_side);
+  }
+};
+
+Renderer::RowBitLight Renderer::row_bit_light(int bit_index, bool positive) const {
+  const int bit_count = config_.geometry.layout.bit_count;
+  const auto shift = static_cast<unsigned>(bit_count - 1 - bit_index);  // Eq. 1: k = 0 is the MSB
+  const auto black = static_cast<float>(config_.effects.projector.black_level);
+  RowBitLight light{
+      gray_.data(), shift, positive ? 0u : 1u, black, 1.0f - black, nullptr, nullptr, nullptr,
+      0.0f,         0.0f};
+  if (!code_position_.empty()) {
+    // Gray bit s of code c is binary bit s XOR bit s+1: it flips at odd multiples of 2^s.
+    light.code_position = code_position_.data();
+    light.inv_blur = inv_blur_codes_.data();
+    light.phi = phi_table_.data();
+    light.period = static_cast<float>(2u << shift);
+    light.first_edge = static_cast<float>(1u << shift);
+  }
+  return light;
 }
 
 geometry::CameraModel Renderer::make_pinhole_and_remap(const geometry::CameraModel& camera) {
@@ -475,6 +567,10 @@ void Renderer::prepare_triangles(const std::vector<RenderObject>& objects) {
       }
     }
     object_T_object_camera_[o] = objects[o].T_camera_object.inverse();
+    if (config_.effects.surface.texture_contrast > 0) {
+      object_T_object_camera_f_.resize(objects.size());
+      object_T_object_camera_f_[o] = object_T_object_camera_[o].cast<float>();
+    }
     std::vector<Eigen::Vector3f>& camera = camera_vertices_[o];
     std::vector<Eigen::Vector3f>& projector = projector_vertices_[o];
     camera.resize(mesh.vertices.size());
@@ -591,6 +687,19 @@ void Renderer::compute_row(int y, Truth* truth) {
   const auto falloff2 =
       static_cast<float>(config_.falloff_reference_m * config_.falloff_reference_m);
   const auto bias = static_cast<float>(config_.shadow_bias_m);
+  const SurfaceEffects& surface = config_.effects.surface;
+  const bool texture = surface.texture_contrast > 0;
+  const auto specular = static_cast<float>(surface.specular_fraction);
+  const auto shininess = static_cast<float>(surface.shininess);
+  const auto specular_cutoff = static_cast<float>(std::pow(1e-3, 1.0 / surface.shininess));
+  const ProjectorOptics& blur = config_.effects.projector;
+  const bool defocus = !code_position_.empty();
+  const auto focus_m = static_cast<float>(blur.focus_distance_m);
+  const auto blur_disc_px =  // x |qz - focus| / qz: the disc's sigma in DMD rows
+      static_cast<float>(blur.aperture_m / blur.focus_distance_m * projector_.fy_px / 4.0);
+  const auto focused_blur2 = static_cast<float>(blur.focused_blur_px * blur.focused_blur_px);
+  const auto first_coded_row = static_cast<float>(config_.geometry.layout.first_row);
+  const auto rows_per_code = static_cast<float>(config_.geometry.layout.rows_per_code);
   const auto scale = static_cast<float>(config_.shadow_map_scale);
   const auto near = shadow_view_.near_m;
   const auto fx = static_cast<float>(projector_.fx_px), fy = static_cast<float>(projector_.fy_px);
@@ -639,14 +748,21 @@ void Renderer::compute_row(int y, Truth* truth) {
         object_checkerboard_[static_cast<std::size_t>(triangle_object_[id])] != nullptr;
     SubSamples* sub = textured && calibration ? &sub_samples_[row_start + x] : nullptr;
     if (calibration) is_sub_sampled_[row_start + x] = sub != nullptr;
-    const float albedo = textured ? kFullScaleDn * textured_albedo(id, x, y, sub) : albedo_dn[id];
+    float albedo = textured ? kFullScaleDn * textured_albedo(id, x, y, sub) : albedo_dn[id];
+    if (texture) {  // mottled paint, fixed to the object (value noise in its frame)
+      const Eigen::Vector3f p_object =
+          object_T_object_camera_f_[static_cast<std::size_t>(triangle_object_[id])] *
+          Eigen::Vector3f(z_row[x] * ray_x[x], z_row[x] * ray_y, z_row[x]);
+      albedo = std::min(albedo * surface.texture_gain(p_object.x(), p_object.y(), p_object.z()),
+                        kFullScaleDn);
+    }
     base_out[x] = albedo * ambient;
     // cos(normal, direction to the projector): n.(c - p) with p = z ray, n.c per triangle.
     const Eigen::Vector3f& n = normals[id];
     const float n_ray = n.x() * ray_x[x] + n.y() * ray_y + n.z();
     float facing = normal_dot_projector[id] - z_row[x] * n_ray;
-    if (n_ray > 0) facing = -facing;  // back face, drawn with culling off
-    if (!(facing > 0)) continue;      // turned away from the projector
+    if (n_ray > 0) facing = -facing;                     // back face, drawn with culling off
+    if (!(facing > 0)) continue;                         // turned away from the projector
     const float u_ideal = u_row[x], v_ideal = v_row[x];  // in the (widened) ideal pinhole
     float u = u_ideal, v = v_ideal;                      // on the DMD
     if (distorted) {
@@ -677,6 +793,25 @@ void Renderer::compute_row(int y, Truth* truth) {
     if (falloff2 > 0) irradiance *= falloff2 * inv_distance[x] * inv_distance[x];
     gain_out[x] = albedo * irradiance;
     if (sub != nullptr) gain_out[x] = kFullScaleDn * irradiance;  // albedo per sub-sample
+    if (specular > 0) {
+      // Blinn-Phong: half vector of the directions to the projector and to the camera.
+      const Eigen::Vector3f p(z_row[x] * ray_x[x], z_row[x] * ray_y, z_row[x]);
+      const Eigen::Vector3f h =
+          ((projector_centre_camera_m_ - p) * inv_distance[x] - p.normalized()).normalized();
+      const float n_h = n_ray > 0 ? -n.dot(h) : n.dot(h);
+      // Below the cutoff the lobe is under 1e-3 of its peak: skip the pow.
+      if (n_h > specular_cutoff) {
+        gain_out[x] += kFullScaleDn * specular * std::pow(n_h, shininess) * irradiance;
+      }
+    }
+    if (defocus && code >= 0) {
+      const std::size_t i = row_start + x;
+      code_position_[i] = (v + 0.5f - first_coded_row) / rows_per_code;
+      // ProjectorOptics::blur_sigma_px, in float (the double version cost a tenth of the pass).
+      const float defocus_px = blur_disc_px * std::abs(qz_row[x] - focus_m) / qz_row[x];
+      const float sigma_px = std::sqrt(defocus_px * defocus_px + focused_blur2);
+      inv_blur_codes_[i] = rows_per_code / std::max(sigma_px, 1e-3f);
+    }
     if constexpr (kWithTruth) {
       truth->projector_column[row_start + x] = u;
       if (code >= 0) {
@@ -709,6 +844,37 @@ void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) 
   const std::int8_t* noise = noise_bank_.data() + offset;
   const float sigma = static_cast<float>(config_.noise_sigma_dn) / kNoiseBankScale;
   std::uint8_t* pixels = out.pixels.data();
+  if (camera_response_) {
+    // EMVA 1288's linear camera: gain and offset non-uniformity, then temporal noise of
+    // variance signal / (e-/DN) + read noise^2 (+ the plain Gaussian noise), then the response
+    // curve. The noise bank holds N(0, 1) x 32.
+    const float fixed_variance = sigma * sigma * kNoiseBankScale * kNoiseBankScale;
+    const float per_electron = dn_per_electron_, read_variance = read_variance_dn2_;
+    const float* prnu = prnu_gain_.data();
+    const float* dsnu = dsnu_dn_.data();
+    const float* gamma = gamma_table_.empty() ? nullptr : gamma_table_.data();
+    for (std::size_t i = 0; i < n; ++i) {
+      float light = 0;
+      if (remap_.empty()) {
+        light = value(i);
+      } else {
+        const RemapEntry& e = remap_[i];
+        light = e.weight[0] * value(e.index[0]) + e.weight[1] * value(e.index[1]) +
+                e.weight[2] * value(e.index[2]) + e.weight[3] * value(e.index[3]);
+      }
+      const float signal = light * prnu[i] + dsnu[i];
+      const float variance = std::max(signal, 0.0f) * per_electron + read_variance + fixed_variance;
+      float v = signal + std::sqrt(variance) * static_cast<float>(noise[i]) / kNoiseBankScale;
+      if (gamma != nullptr) {
+        const float k = std::min(std::max(v, 0.0f), 255.0f) * 4.0f;
+        const auto k0 = static_cast<std::size_t>(k);
+        const std::size_t k1 = std::min<std::size_t>(k0 + 1, 1024);
+        v = gamma[k0] + (gamma[k1] - gamma[k0]) * (k - static_cast<float>(k0));
+      }
+      pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v + 0.5f, 0.0f), kFullScaleDn));
+    }
+    return;
+  }
   if (remap_.empty()) {
     for (std::size_t i = 0; i < n; ++i) {
       const float v = value(i) + sigma * static_cast<float>(noise[i]) + 0.5f;
@@ -725,16 +891,19 @@ void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) 
   }
 }
 
-void Renderer::shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out) const {
-  shade(FramePattern{ProjectorFrame::kRowBit, bit_index, positive}, noise_key, out);
+void Renderer::shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out,
+                     float ambient_gain) const {
+  shade(FramePattern{ProjectorFrame::kRowBit, bit_index, positive}, noise_key, out, ambient_gain);
 }
 
-void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out) const {
+void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out,
+                     float ambient_gain) const {
   const float* base = base_dn_.data();
   const float* gain = gain_dn_.data();
+  const float ambient = ambient_gain;  // x 1.0f is exact: the steady-light images are unchanged
   if (pattern.frame == ProjectorFrame::kBlack) {
     quantise(
-        noise_key, [&](std::size_t i) { return base[i]; }, out);
+        noise_key, [&](std::size_t i) { return base[i] * ambient; }, out);
     return;
   }
   if (!calibration_patterns_ && pattern.frame != ProjectorFrame::kRowBit) {
@@ -750,12 +919,12 @@ void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoI
     quantise(
         noise_key,
         [&](std::size_t i) {
-          if (!sub_sampled[i]) return base[i] + gain[i];
+          if (!sub_sampled[i]) return base[i] * ambient + gain[i];
           int sum = 0;
           for (int s = 0; s < kSubSamples; ++s) {
             sum += subs[i].albedo[s] * ((subs[i].row_gray[s] | subs[i].column_gray[s]) >> 15);
           }
-          return base[i] + gain[i] * kSubScale * static_cast<float>(sum);
+          return base[i] * ambient + gain[i] * kSubScale * static_cast<float>(sum);
         },
         out);
     return;
@@ -774,38 +943,55 @@ void Renderer::shade(const FramePattern& pattern, std::uint64_t noise_key, MonoI
     // Uncoded pixels (no kCoded flag) are dark in both polarities.
     return (((g >> shift) & 1u) ^ flip) & (g >> 15);
   };
+  if (!calibration_patterns_ && pattern_effects_) {
+    const RowBitLight light = row_bit_light(pattern.bit_index, pattern.positive);
+    quantise(
+        noise_key, [&](std::size_t i) { return base[i] * ambient + gain[i] * light(i); }, out);
+    return;
+  }
   if (!calibration_patterns_) {
     quantise(
         noise_key,
-        [&](std::size_t i) { return base[i] + gain[i] * static_cast<float>(bit_of(gray[i])); },
+        [&](std::size_t i) {
+          return base[i] * ambient + gain[i] * static_cast<float>(bit_of(gray[i]));
+        },
         out);
     return;
   }
   quantise(
       noise_key,
       [&](std::size_t i) {
-        if (!sub_sampled[i]) return base[i] + gain[i] * static_cast<float>(bit_of(gray[i]));
+        if (!sub_sampled[i]) {
+          return base[i] * ambient + gain[i] * static_cast<float>(bit_of(gray[i]));
+        }
         const std::uint16_t* sub_gray = columns ? subs[i].column_gray : subs[i].row_gray;
         int sum = 0;
         for (int s = 0; s < kSubSamples; ++s) sum += subs[i].albedo[s] * bit_of(sub_gray[s]);
-        return base[i] + gain[i] * kSubScale * static_cast<float>(sum);
+        return base[i] * ambient + gain[i] * kSubScale * static_cast<float>(sum);
       },
       out);
 }
 
-void Renderer::accumulate(int bit_index, bool positive, float weight,
-                          std::vector<float>& sum) const {
+void Renderer::accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum,
+                          float ambient_gain) const {
   if (calibration_patterns_) {
     // Sub-sampled pixels keep their albedo per sub-sample, which this sum does not read.
     throw std::logic_error("sim::Renderer: motion blur is not rendered with calibration patterns");
   }
   sum.resize(base_dn_.size(), 0.0f);
+  if (pattern_effects_) {
+    const RowBitLight light = row_bit_light(bit_index, positive);
+    for (std::size_t i = 0; i < sum.size(); ++i) {
+      sum[i] += weight * (base_dn_[i] * ambient_gain + gain_dn_[i] * light(i));
+    }
+    return;
+  }
   const int shift = config_.geometry.layout.bit_count - 1 - bit_index;
   const unsigned flip = positive ? 0u : 1u;
   for (std::size_t i = 0; i < sum.size(); ++i) {
     const auto g = static_cast<unsigned>(gray_[i]);
     const unsigned bit = (((g >> shift) & 1u) ^ flip) & (g >> 15);
-    sum[i] += weight * (base_dn_[i] + gain_dn_[i] * static_cast<float>(bit));
+    sum[i] += weight * (base_dn_[i] * ambient_gain + gain_dn_[i] * static_cast<float>(bit));
   }
 }
 

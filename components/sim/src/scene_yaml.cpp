@@ -16,6 +16,7 @@
 #include "avs/geometry/primitives.hpp"
 #include "avs/runtime/text.hpp"
 #include "avs/runtime/yaml_checks.hpp"
+#include "avs/sim/sensor_profile.hpp"
 
 namespace avs::sim {
 namespace {
@@ -181,6 +182,15 @@ class Parser {
   void sensor(const YAML::Node& node, SimulatorConfig& c) const {
     if (!node) return;
     RendererConfig& r = c.renderer;
+    // A named profile first (issue 19), so that the keys below override single values of it.
+    if (const YAML::Node profile = node["profile"]) {
+      try {
+        apply_sensor_profile(parse_sensor_profile(profile.as<std::string>()), c);
+      } catch (const std::exception& e) {
+        fail(profile, e.what());
+      }
+    }
+    effects(node, r.effects);
     r.ambient_level = get(node, "ambient_level", r.ambient_level);
     r.projector_level = get(node, "projector_level", r.projector_level);
     r.falloff_reference_m = get(node, "falloff_reference_m", r.falloff_reference_m);
@@ -192,6 +202,34 @@ class Parser {
     c.frame_rate_hz = get(node, "frame_rate_hz", c.frame_rate_hz);
     c.exposure_s = get(node, "exposure_s", c.exposure_s);
     c.motion_blur_samples = get(node, "motion_blur_samples", c.motion_blur_samples);
+  }
+
+  /// sensor.projector, .camera, .ambient_flicker and .surface: single effect values.
+  void effects(const YAML::Node& node, SensorEffects& e) const {
+    if (const YAML::Node p = node["projector"]) {
+      e.projector.black_level = get(p, "black_level", e.projector.black_level);
+      e.projector.aperture_m = get(p, "aperture_m", e.projector.aperture_m);
+      e.projector.focus_distance_m = get(p, "focus_distance_m", e.projector.focus_distance_m);
+      e.projector.focused_blur_px = get(p, "focused_blur_px", e.projector.focused_blur_px);
+    }
+    if (const YAML::Node m = node["camera"]) {
+      e.camera.full_well_e = get(m, "full_well_e", e.camera.full_well_e);
+      e.camera.read_noise_e = get(m, "read_noise_e", e.camera.read_noise_e);
+      e.camera.prnu_fraction = get(m, "prnu_fraction", e.camera.prnu_fraction);
+      e.camera.dsnu_dn = get(m, "dsnu_dn", e.camera.dsnu_dn);
+      e.camera.gamma = get(m, "gamma", e.camera.gamma);
+    }
+    if (const YAML::Node a = node["ambient_flicker"]) {
+      e.ambient.modulation = get(a, "modulation", e.ambient.modulation);
+      e.ambient.frequency_hz = get(a, "frequency_hz", e.ambient.frequency_hz);
+    }
+    if (const YAML::Node f = node["surface"]) {
+      e.surface.specular_fraction = get(f, "specular_fraction", e.surface.specular_fraction);
+      e.surface.shininess = get(f, "shininess", e.surface.shininess);
+      e.surface.texture_contrast = get(f, "texture_contrast", e.surface.texture_contrast);
+      e.surface.texture_scale_m = get(f, "texture_scale_m", e.surface.texture_scale_m);
+    }
+    if (const std::string problem = e.problem(); !problem.empty()) fail(node, problem);
   }
 
   void head(const YAML::Node& node, HeadConfig& h) const {

@@ -21,6 +21,7 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/rejections.hpp"
 #include "avs/sim/scene_yaml.hpp"
+#include "avs/sim/sensor_profile.hpp"
 #include "avs/sim/simulator.hpp"
 #include "scene_path.hpp"
 
@@ -125,6 +126,13 @@ class SimScene final : public runtime::Component {
              ParamSpec::real("noise_sigma_dn", -1.0, -1.0, 100.0, "DN",
                              "sensor noise sigma; -1: as in the scene (default " +
                                  text(sim.renderer.noise_sigma_dn) + ")"),
+             ParamSpec::string("sensor_profile", "",
+                               "optics and sensor effects (docs/sim.md, sensor profiles): "
+                               "ideal (sharp pinhole optics, Gaussian noise, matte paint) or "
+                               "realistic (defocus, shot and read noise, gloss, texture, "
+                               "flicker, motion blur); empty: as in the scene (sensor.profile, "
+                               "default ideal)",
+                               {"", "ideal", "realistic"}),
              ParamSpec::integer("motion_blur_samples", 0, 0, 64, "",
                                 "poses averaged over the exposure; 0: as in the scene "
                                 "(default " +
@@ -175,7 +183,10 @@ class SimScene final : public runtime::Component {
     log().info("scene ", scene_name_, ":", objects, "; ", c.frame_rate_hz, " Hz on the ",
                ctx.uses_sim_time() ? "simulated" : "wall", " clock, noise ",
                c.renderer.noise_sigma_dn, " DN seed ", c.renderer.noise_seed, ", blur samples ",
-               c.motion_blur_samples);
+               c.motion_blur_samples, ", ",
+               c.renderer.effects.changes_pattern_light() || !c.renderer.effects.camera.is_ideal()
+                   ? "optics and sensor effects on (docs/sim.md)"
+                   : "ideal optics and sensor");
   }
 
   void on_activate() override {
@@ -259,6 +270,9 @@ class SimScene final : public runtime::Component {
     SimulatorConfig& c = file.config;
     if (const auto seed = ctx.param<std::int64_t>("seed"); seed >= 0) {
       c.renderer.noise_seed = static_cast<std::uint64_t>(seed);
+    }
+    if (const std::string profile = ctx.param<std::string>("sensor_profile"); !profile.empty()) {
+      apply_sensor_profile(parse_sensor_profile(profile), c);
     }
     if (const double sigma = ctx.param<double>("noise_sigma_dn"); sigma >= 0) {
       c.renderer.noise_sigma_dn = sigma;

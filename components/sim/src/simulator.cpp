@@ -53,9 +53,13 @@ SimFrame Simulator::render(std::uint64_t frame_index, double time_s, const HeadS
   frame.pattern = pattern_slot(frame_index, config_.renderer.geometry.layout.bit_count);
   const std::uint64_t noise_key = frame_noise_key(frame_index);
   const int samples = config_.motion_blur_samples;
+  // Flickering room light: its mean over this frame's exposure.
+  const auto ambient =
+      static_cast<float>(config_.renderer.effects.ambient.mean_gain(time_s, config_.exposure_s));
   if (samples == 1 || config_.exposure_s == 0) {
     set_view_at(time_s, head);
-    renderer_.shade(frame.pattern.bit_index, frame.pattern.positive, noise_key, frame.image);
+    renderer_.shade(frame.pattern.bit_index, frame.pattern.positive, noise_key, frame.image,
+                    ambient);
   } else {
     // Sub-exposures at offsets (k + 0.5) / samples - 0.5 of the exposure; the one nearest the
     // centre is rendered last so the renderer's ground truth describes the centre.
@@ -69,7 +73,7 @@ SimFrame Simulator::render(std::uint64_t frame_index, double time_s, const HeadS
       h.tilt_rad += head.tilt_rate_rad_s * dt;
       set_view_at(time_s + dt, h);
       renderer_.accumulate(frame.pattern.bit_index, frame.pattern.positive, 1.0f / samples,
-                           blur_sum_);
+                           blur_sum_, ambient);
     }
     renderer_.finish(blur_sum_, noise_key, frame.image);
   }

@@ -19,6 +19,7 @@
 #include "avs/geometry/mesh.hpp"
 #include "avs/sim/checkerboard.hpp"
 #include "avs/sim/rasterizer.hpp"
+#include "avs/sim/sensor_effects.hpp"
 
 namespace avs::sim {
 
@@ -55,6 +56,10 @@ struct RendererConfig {
   /// DMD (our choice for speed: 0.5 gives 2 x 2 DMD pixels per cell, about 1.6 mm at 1 m).
   double shadow_map_scale = 0.5;
   double near_clip_m = 0.05;
+  /// Optics, sensor, surface and light effects of a real rig (issue 19), all off by default
+  /// (sensor_profile.hpp sets them by name). Projector and surface effects are rendered for
+  /// the row codes only: with column_layout they throw std::invalid_argument.
+  SensorEffects effects;
 };
 
 /// What the projector shows in one frame: a bit of the row code (Eq. 1, geometry.layout), a
@@ -104,15 +109,19 @@ class Renderer {
 
   /// Frame with bit `bit_index` (0 = MSB) of the pattern, positive or negative, noise drawn
   /// from (noise_seed, noise_key): the same key gives the same image.
-  void shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out) const;
+  /// `ambient_gain` scales the room light (effects.ambient: its mean over the exposure).
+  void shade(int bit_index, bool positive, std::uint64_t noise_key, MonoImage& out,
+             float ambient_gain = 1.0f) const;
   /// Any frame (row or column bit, white, black); column and white frames need
   /// RendererConfig::column_layout (std::logic_error otherwise).
-  void shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out) const;
+  void shade(const FramePattern& pattern, std::uint64_t noise_key, MonoImage& out,
+             float ambient_gain = 1.0f) const;
 
   /// Motion blur: adds weight x the noise-free intensity (DN) of the current view to `sum`
   /// (width*height floats); finish() adds noise and quantises. Row codes only: throws
   /// std::logic_error with calibration patterns (RendererConfig::column_layout).
-  void accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum) const;
+  void accumulate(int bit_index, bool positive, float weight, std::vector<float>& sum,
+                  float ambient_gain = 1.0f) const;
   void finish(const std::vector<float>& sum, std::uint64_t noise_key, MonoImage& out) const;
 
   // Ground truth of the current view, per camera pixel (row-major). Computed on the first
@@ -157,6 +166,13 @@ class Renderer {
   geometry::CameraModel make_projector_pinhole(const geometry::CameraModel& projector);
   template <typename ValueFn>
   void quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) const;
+  /// Light of row bit `bit_index` (0 = MSB) at pinhole pixel i, 0..1 of the projector's: the
+  /// sharp bit, or with effects the defocused edge and the black level.
+  struct RowBitLight;
+  RowBitLight row_bit_light(int bit_index, bool positive) const;
+  /// Checks config_.effects and builds their tables (fixed pattern, response curve, normal CDF)
+  /// and per-pixel buffers; `pinhole` is the camera view the geometry pass renders.
+  void set_up_effects(const geometry::CameraModel& pinhole);
 
   RendererConfig config_;
   PinholeView camera_view_, shadow_view_;
@@ -165,7 +181,7 @@ class Renderer {
   bool calibration_patterns_ = false;   ///< column_layout set: every DMD row lit and tested
   std::vector<std::int16_t> row_code_;  ///< code of each projector row, -1 if uncoded
   std::vector<std::int16_t> column_code_;  ///< code of each projector column (column_layout)
-  std::vector<std::int8_t> noise_bank_;  ///< N(0, 1) samples x 32, drawn once from noise_seed
+  std::vector<std::int8_t> noise_bank_;    ///< N(0, 1) samples x 32, drawn once from noise_seed
   Eigen::Matrix3f R_projector_camera_;
   Eigen::Vector3f t_projector_camera_m_, projector_centre_camera_m_;
   std::vector<float> ray_x_, ray_y_;                   ///< normalised camera ray per column / row
@@ -222,6 +238,16 @@ class Renderer {
   };
   std::vector<RemapEntry> remap_;
   mutable Truth truth_camera_;  ///< truth_ remapped to the camera's pixels (distortion only)
+  // Sensor effects (config_.effects), sized only when the effect is on.
+  bool pattern_effects_ = false;       ///< effects.changes_pattern_light()
+  std::vector<float> code_position_;   ///< per pinhole pixel: continuous code (defocus)
+  std::vector<float> inv_blur_codes_;  ///< per pinhole pixel: 1 / edge blur sigma, in codes
+  std::vector<float> phi_table_;       ///< standard normal CDF on [0, 4), 128 per unit
+  std::vector<Eigen::Isometry3f> object_T_object_camera_f_;  ///< texture lookup
+  bool camera_response_ = false;                             ///< !effects.camera.is_ideal()
+  std::vector<float> prnu_gain_, dsnu_dn_;                   ///< per camera pixel, fixed pattern
+  float dn_per_electron_ = 0, read_variance_dn2_ = 0;
+  std::vector<float> gamma_table_;  ///< 255 (s / 255)^(1 / gamma) at s = k / 4, k = 0..1024
 };
 
 /// The noise key of a frame: mixes the frame index so consecutive frames are independent.
