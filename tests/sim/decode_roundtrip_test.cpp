@@ -11,6 +11,7 @@
 
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/geometry/builtin_models.hpp"
+#include "avs/sim/pattern_frame.hpp"
 #include "avs/sim/simulator.hpp"
 
 namespace avs::sim {
@@ -38,12 +39,7 @@ TEST(DecodeRoundTrip, OneCycleOfTheKenDecodesToTheTrueDepth) {
   for (int f = 0; f < frames; ++f) {
     kept.push_back(sim.render(static_cast<std::uint64_t>(f), head));
     const SimFrame& frame = kept.back();
-    decode::PatternFrame input;
-    input.image = {frame.image.pixels.data(), frame.image.width, frame.image.height, 0};
-    input.bit_index = frame.pattern.bit_index;
-    input.polarity =
-        frame.pattern.positive ? decode::Polarity::kPositive : decode::Polarity::kNegative;
-    input.cycle = frame.pattern.cycle;
+    const decode::PatternFrame input = pattern_frame(frame);
     result = decoder.push_frame(input);
   }
   ASSERT_TRUE(result.depth_updated);

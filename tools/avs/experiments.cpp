@@ -115,7 +115,14 @@ void add_experiments_command(Command& app) {
   static double time_scale = 1.0;
   static std::string calibration;
   static std::string true_calibration;
+  static std::string profile = "ideal";
   cmd->add_option("NAME", names, "experiments to run (default: all)");
+  cmd->add_option("--profile", profile,
+                  "simulated optics and sensor (docs/sim.md, sensor profiles): ideal (the "
+                  "renderer of the published figures) or realistic (defocus, shot and read "
+                  "noise, gloss, texture, flicker, motion blur)")
+      ->check_member({"ideal", "realistic"})
+      ->capture_default_str();
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
                   "decoder only; tracking, matching and the recorder take the camera model "
@@ -151,6 +158,10 @@ void add_experiments_command(Command& app) {
       if (interrupted_by_signal()) break;
       e.run.dir = root / e.name;
       e.run.duration_s *= time_scale;
+      e.run.extra_args["sensor_profile"] = profile;
+      if (profile != "ideal") {
+        e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("sensor profile ") + profile;
+      }
       if (!calibration.empty()) {
         e.run.extra_args["calibration"] = std::filesystem::absolute(calibration).string();
         e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("calibration ") +

@@ -1,6 +1,9 @@
-// avs_sim_snapshot SCENE.yaml OUT_DIR [TIME_S]
+// avs_sim_snapshot SCENE.yaml OUT_DIR [TIME_S] [PROFILES_PNG]
 // Renders the 2n pattern frames of one cycle at TIME_S (default 0) with the head aimed at
 // the first object, and writes OUT_DIR/frame_XX.pgm plus OUT_DIR/depth.pgm (near = bright).
+// With PROFILES_PNG, also the figure of docs/sim.md's sensor profiles: the image centre
+// (160 x 160 pixels, shown 2x) of three frames (bit 5 positive, the last bit positive and
+// negative), rendered in the ideal profile (top row) and the realistic one (bottom row).
 #include <algorithm>
 #include <cstdlib>
 #include <exception>
@@ -8,7 +11,9 @@
 #include <iostream>
 #include <string>
 
+#include "avs/decode/png_io.hpp"
 #include "avs/sim/scene_yaml.hpp"
+#include "avs/sim/sensor_profile.hpp"
 #include "avs/sim/simulator.hpp"
 
 namespace {
@@ -20,11 +25,42 @@ void write_pgm(const std::string& path, int width, int height, const std::uint8_
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
+/// The profiles figure (see the file comment); frame indices are those of the cycle at t.
+void write_profiles_png(const std::string& path, const avs::sim::SceneFile& file, double t,
+                        const avs::sim::HeadState& head) {
+  constexpr int kCrop = 160, kZoom = 2;
+  const int bits = file.config.renderer.geometry.layout.bit_count;
+  const int frames[3] = {2 * 5, 2 * (bits - 1), 2 * (bits - 1) + 1};
+  avs::decode::GrayImage8 figure;
+  figure.width = 3 * kCrop * kZoom + 2 * 4;
+  figure.height = 2 * kCrop * kZoom + 4;
+  figure.pixels.assign(static_cast<std::size_t>(figure.width) * figure.height, 255);
+  for (int row = 0; row < 2; ++row) {
+    avs::sim::SimulatorConfig config = file.config;
+    avs::sim::apply_sensor_profile(
+        row == 0 ? avs::sim::SensorProfile::kIdeal : avs::sim::SensorProfile::kRealistic, config);
+    avs::sim::Simulator sim(config, file.scene);
+    for (int column = 0; column < 3; ++column) {
+      const avs::sim::SimFrame frame =
+          sim.render(static_cast<std::uint64_t>(frames[column]), t, head);
+      const int x0 = frame.image.width / 2 - kCrop / 2, y0 = frame.image.height / 2 - kCrop / 2;
+      for (int y = 0; y < kCrop * kZoom; ++y) {
+        for (int x = 0; x < kCrop * kZoom; ++x) {
+          const int out_x = column * (kCrop * kZoom + 4) + x, out_y = row * (kCrop * kZoom + 4) + y;
+          figure.pixels[static_cast<std::size_t>(out_y) * figure.width + out_x] =
+              frame.image.at(x0 + x / kZoom, y0 + y / kZoom);
+        }
+      }
+    }
+  }
+  avs::decode::write_png_gray8(path, figure);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr << "usage: " << argv[0] << " SCENE.yaml OUT_DIR [TIME_S]\n";
+    std::cerr << "usage: " << argv[0] << " SCENE.yaml OUT_DIR [TIME_S] [PROFILES_PNG]\n";
     return 2;
   }
   try {
@@ -34,6 +70,10 @@ int main(int argc, char** argv) {
     if (!file.scene.objects.empty()) {
       head = avs::sim::at_rest(avs::geometry::look_at(
           file.config.head, file.scene.objects[0].trajectory->T_world_object(t).translation()));
+    }
+    if (argc > 4) {
+      write_profiles_png(argv[4], file, t, head);
+      std::cout << "wrote " << argv[4] << '\n';
     }
     avs::sim::Simulator sim(file.config, std::move(file.scene));
     const int frames = 2 * sim.config().renderer.geometry.layout.bit_count;
