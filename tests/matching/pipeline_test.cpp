@@ -1,9 +1,12 @@
 // MatchingPipeline: a target cut by the image border gives no pose (the visible part would be
 // fitted anywhere) and the tracker starts over; the whole target is matched.
+#include <limits>
 #include <stdexcept>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "avs/matching/border_regions.hpp"
 #include "avs/matching/model_cloud.hpp"
 #include "avs/matching/pipeline.hpp"
 #include "avs/matching/synthetic.hpp"
@@ -53,6 +56,43 @@ TEST(MatchingPipeline, TargetCutByTheImageBorderGivesNoPose) {
                              config);
   out = unguarded.process(cut.view(), 0.0);
   EXPECT_FALSE(out.truncated);
+}
+
+// BorderRegions: a board entering from the left edge (0.6 m, a gentle slope) is marked; a
+// target in the middle (1.0 m) is kept, also where it touches the board in the image (a 0.4 m
+// depth step); pixels outside the depth window are neither.
+TEST(BorderRegions, MarksWhatTouchesTheBorderThroughSmoothDepth) {
+  constexpr int kW = 64, kH = 48;
+  std::vector<float> depth(kW * kH, std::numeric_limits<float>::quiet_NaN());
+  int board = 0, target = 0;
+  for (int v = 0; v < kH; ++v) {
+    for (int u = 0; u < kW; ++u) {
+      float& z = depth[static_cast<std::size_t>(v) * kW + u];
+      if (u < 20) {
+        z = 0.6F + 0.001F * static_cast<float>(u);  // the board, slightly slanted
+        ++board;
+      } else if (u < 40 && v > 10 && v < 30) {
+        z = 1.0F;  // the target, touching the board at u = 20
+        ++target;
+      } else if (u >= 40) {
+        z = 2.0F;  // the wall beyond the depth window
+      }
+    }
+  }
+  BorderRegions regions;
+  const std::size_t marked = regions.mark({depth.data(), kW, kH, 0}, 0.3F, 1.5F, 0.02F);
+  EXPECT_EQ(marked, static_cast<std::size_t>(board));
+  const std::uint8_t* keep = regions.keep_mask();
+  EXPECT_EQ(keep[5 * kW + 3], 0) << "board";
+  EXPECT_EQ(keep[20 * kW + 20], 1) << "target beside the board";
+  EXPECT_EQ(keep[20 * kW + 50], 1) << "outside the window: not marked";
+  // A smooth ramp from the board into the target joins them.
+  for (int u = 20; u < 30; ++u)
+    depth[static_cast<std::size_t>(20) * kW + u] = 0.62F + 0.01F * (u - 20);
+  for (int u = 30; u < 40; ++u)
+    depth[static_cast<std::size_t>(20) * kW + u] = 0.72F + 0.03F * (u - 30);
+  EXPECT_GT(regions.mark({depth.data(), kW, kH, 0}, 0.3F, 1.5F, 0.02F),
+            static_cast<std::size_t>(board));
 }
 
 TEST(MatchingPipeline, RetuneChangesTheLiveSettingsAndKeepsTheTrackingState) {

@@ -108,12 +108,23 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
   const double data_stamp_s = aged ? stamp_s - data_age_s : stamp_s;
   const auto start = std::chrono::steady_clock::now();
   PipelineOutput out;
-  scene_ = &builder_.build(depth, {}, config_.camera);
-  out.valid_pixels = builder_.valid_pixels();
-  out.scene_points = scene_->size();
   out.border_pixels = border_pixels(depth);
   out.truncated = config_.max_border_pixels >= 0 &&
                   out.border_pixels > static_cast<std::size_t>(config_.max_border_pixels);
+  MaskView mask;
+  if (out.truncated && config_.min_pixels_beside_border_clutter > 0) {
+    // Clutter that enters from the side: match what is not connected to the border, if enough.
+    out.border_clutter_pixels = border_regions_.mark(
+        depth, config_.depth_min_m, config_.depth_max_m, config_.border_region_step_m);
+    mask.mask = border_regions_.keep_mask();
+  }
+  scene_ = &builder_.build(depth, mask, config_.camera);
+  out.valid_pixels = builder_.valid_pixels();
+  out.scene_points = scene_->size();
+  if (mask.mask != nullptr) {
+    out.truncated =
+        out.valid_pixels < static_cast<std::size_t>(config_.min_pixels_beside_border_clutter);
+  }
   if (out.truncated) {
     // Partly out of view: no pose, and a fresh initial alignment once the target is whole.
     tracker_.reset();

@@ -1,5 +1,6 @@
 #include "avs/matching/tracker.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -48,8 +49,8 @@ Tracker::Tracker(const ModelCloud& model, TrackerConfig config)
         std::to_string(model.dense_normals.size()) + " normals)");
   }
   default_max_rmse_m_ = config_.dense_icp_model && model.mean_spacing_m > 0.0F
-                           ? model.mean_spacing_m
-                           : icp_.model_spacing_m();
+                            ? model.mean_spacing_m
+                            : icp_.model_spacing_m();
   if (!(config_.max_rmse_m > 0.0F)) config_.max_rmse_m = default_max_rmse_m_;
 }
 
@@ -113,7 +114,10 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
   result.icp = icp_.align(p_camera, guess);
   result.T_camera_model = result.icp.T_camera_model;
   result.pose_valid = result.icp.valid && result.icp.rmse_m <= config_.max_rmse_m &&
-                      result.icp.inlier_ratio() >= config_.min_inlier_ratio;
+                      result.icp.inlier_ratio() >= (result.initialised_this_frame
+                                                        ? std::max(config_.min_inlier_ratio,
+                                                                   config_.min_initial_inlier_ratio)
+                                                        : config_.min_inlier_ratio);
 
   // 3. State machine: failures in a row declare the target lost; a lost target re-initialises.
   if (result.pose_valid) {

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "avs/geometry/mesh.hpp"
+#include "avs/matching/border_regions.hpp"
 #include "avs/matching/model_cloud.hpp"
 #include "avs/matching/pose_error.hpp"
 #include "avs/matching/scene_cloud.hpp"
@@ -40,6 +41,13 @@ struct PipelineConfig {
   /// visible part anywhere, so the frame gives no pose and the tracker starts over when the
   /// target is whole again. Negative: off.
   int max_border_pixels = 20;
+  /// Clutter cut by the border (issue 19: a board crossing the view in front of the target):
+  /// when more than max_border_pixels target-window pixels are on the border, the surfaces
+  /// connected to the border through depth steps of at most border_region_step_m are left out
+  /// (BorderRegions), and if at least this many target-window pixels remain, the frame is
+  /// matched on them instead of being given up. 0: every such frame is given up.
+  int min_pixels_beside_border_clutter = 200;
+  float border_region_step_m = 0.02F;
 };
 
 /// Per-frame result of MatchingPipeline::process().
@@ -54,7 +62,9 @@ struct PipelineOutput {
   std::size_t scene_points = 0;
   std::size_t border_pixels = 0;  ///< target-window pixels on the image border
   bool truncated = false;         ///< border_pixels > max_border_pixels: no pose
-  double processing_ms = 0.0;     ///< wall-clock time of process()
+  /// Target-window pixels left out as clutter cut by the border (0 when none was).
+  std::size_t border_clutter_pixels = 0;
+  double processing_ms = 0.0;  ///< wall-clock time of process()
 };
 
 class MatchingPipeline {
@@ -89,6 +99,7 @@ class MatchingPipeline {
   ModelCloud model_;
   PipelineConfig config_;
   SceneCloudBuilder builder_;
+  BorderRegions border_regions_;
   Tracker tracker_;
   const Points* scene_;
   Points empty_;

@@ -22,12 +22,16 @@ struct TrackerConfig {
   /// alignment still uses the M-PCD. Inlier distance and max_rmse_m default to the M-PCD's
   /// spacing either way.
   bool dense_icp_model = false;
-  InitialAlignmentConfig initial;     ///< used on the first frame and after a loss
-  bool constant_velocity = true;      ///< predict from the last two poses
+  InitialAlignmentConfig initial;  ///< used on the first frame and after a loss
+  bool constant_velocity = true;   ///< predict from the last two poses
   /// Above this ICP RMSE the frame fails (0 = the model's mean spacing). 15 mm: what every
   /// experiment runs with (the matching component's default).
   float max_rmse_m = 0.015F;
-  float min_inlier_ratio = 0.3F;      ///< below this the frame is a failure (as the experiments)
+  float min_inlier_ratio = 0.3F;  ///< below this the frame is a failure (as the experiments)
+  /// A frame that ran the initial alignment must reach this inlier ratio (issue 19, occlusion:
+  /// with the target hidden, a sliver of it plus an occluder's edge aligned at 0.31-0.35 and
+  /// flipped the pose; a whole target aligns at 0.8 and more).
+  float min_initial_inlier_ratio = 0.6F;
   int failures_before_loss = 3;       ///< consecutive failures that declare the target lost
   std::size_t min_scene_points = 15;  ///< fewer: no update (counts as a failure)
 };
