@@ -22,6 +22,7 @@
 #include <gtest/gtest.h>
 
 #include "avs/decode/rolling_decoder.hpp"
+#include "avs/geometry/primitives.hpp"
 #include "avs/matching/pipeline.hpp"
 #include "avs/sim/pattern_frame.hpp"
 #include "avs/sim/sensor_profile.hpp"
@@ -72,6 +73,24 @@ struct Setup {
   /// at 0.8 m/s between occluder_start_s and +1.5 s, passing in front of the target.
   bool occluder = false;
   double occluder_start_s = 1.0;
+  /// Issue 19 clutter: a hand-sized box (70 x 50 x 70 mm) round the middle of the ken's handle
+  /// moves with the ken, hiding that part of it all the time.
+  bool holder = false;
+};
+
+/// A pose fixed in a moving object's frame (what a hand holding the object does).
+class AttachedTrajectory final : public sim::Trajectory {
+ public:
+  AttachedTrajectory(std::shared_ptr<const sim::Trajectory> parent,
+                     Eigen::Isometry3d T_parent_child)
+      : parent_(std::move(parent)), T_parent_child_(T_parent_child) {}
+  Eigen::Isometry3d T_world_object(double t_s) const override {
+    return parent_->T_world_object(t_s) * T_parent_child_;
+  }
+
+ private:
+  std::shared_ptr<const sim::Trajectory> parent_;
+  Eigen::Isometry3d T_parent_child_;
 };
 
 Run run(const Setup& setup) {
@@ -112,6 +131,16 @@ Run run(const Setup& setup) {
                                    {t0, Eigen::Vector3d(0.6, y0, 0.0), q},
                                    {t0 + 1.5, Eigen::Vector3d(0.6, -y0, 0.0), q}});
     scene.objects.push_back(board);
+  }
+  if (setup.holder) {
+    sim::SceneObject hand;
+    hand.name = "hand";
+    hand.mesh = std::make_shared<const geometry::Mesh>(
+        geometry::make_box(Eigen::Vector3d(0.07, 0.05, 0.07)));
+    hand.albedo = 0.6;
+    hand.trajectory = std::make_shared<AttachedTrajectory>(
+        target.trajectory, Eigen::Isometry3d(Eigen::Translation3d(0, -0.055, 0)));
+    scene.objects.push_back(hand);
   }
   sim::Simulator simulator(sim_config, scene);
 
@@ -386,6 +415,16 @@ TEST(SimAccuracy, KenBehindACrossingBoardIsLostThenReacquired) {
   ASSERT_GE(r.whole_again_s, 0);
   ASSERT_GE(r.reacquired_s, 0) << "never re-acquired";
   EXPECT_LE(r.reacquired_s - r.whole_again_s, 0.050);
+}
+// Issue 19 clutter: the ken held by a hand-sized box round its handle all the time. The box is
+// inside the depth window and touches the ken, so it is part of the scene cloud: matching must
+// still never flip and keep the goals. NOT MET, so disabled (gtest lists it as disabled on every
+// run; run it with --gtest_also_run_disabled_tests): 52.9 mm / 75 deg RMS, 494 flips. The
+// initial alignment takes the box's front face for the ken's (15.6 mm towards the camera, 18
+// deg) and the per-frame ICP, whose 15 mm pairs then reach the box, drifts from there
+// (docs/matching.md, "Clutter that moves with the target").
+TEST(SimAccuracy, DISABLED_KenHeldByAHandSizedBox) {
+  check({.object = "ken", .follow = true, .closed_loop_tuning = true, .holder = true}, 3.0, 2.0);
 }
 // The plain decoder path: code centres, pose published as matched.
 TEST(SimAccuracy, KenWithCodeCentresAndNoAgeCompensation) {
