@@ -7,6 +7,7 @@
 
 #include "avs/report/paper.hpp"
 #include "avs/report/report.hpp"
+#include "avs/report/seeds.hpp"
 #include "avs/report/table.hpp"
 #include "closed_loop.hpp"
 #include "commands.hpp"
@@ -116,6 +117,7 @@ void add_experiments_command(Command& app) {
   static std::string calibration;
   static std::string true_calibration;
   static std::string profile = "ideal";
+  static int seeds = 1;
   cmd->add_option("NAME", names, "experiments to run (default: all)");
   cmd->add_option("--profile", profile,
                   "simulated optics and sensor (docs/sim.md, sensor profiles): ideal (the "
@@ -133,6 +135,11 @@ void add_experiments_command(Command& app) {
                   "the decoder gets --calibration (e.g. one recovered by avs calib solve), the "
                   "simulator this truth")
       ->check_existing_file();
+  cmd->add_option("--seeds", seeds,
+                  "run each scenario with sensor noise seeds 1..N (folders <out>/<name>/seed-<k>) "
+                  "and report the median of each figure, with the smallest and largest")
+      ->check_range(1, 20)
+      ->capture_default_str();
   cmd->add_flag("--json", json, "print one JSON object keyed by scenario name on stdout");
   cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
   cmd->add_option("--time-scale", time_scale,
@@ -173,27 +180,53 @@ void add_experiments_command(Command& app) {
                        std::filesystem::path(true_calibration).filename().string();
       }
       std::cerr << "== " << e.name << " (Sec. " << e.section << "): " << e.what << "\n";
-      const ClosedLoopOutcome outcome = run_closed_loop(e.run, std::cerr);
-      if (outcome.status != 0) status = outcome.status;
-      try {
-        const report::Report r = report::make_report(e.run.dir);
-        for (const auto& failed : r.plots.failed) {
-          std::cerr << "FAILED figure " << failed.png << ": " << failed.reason << "\n";
+      // One run per seed; with one seed the run folder is <out>/<name> as before.
+      std::vector<report::Summary> per_seed;
+      std::filesystem::path index_dir = e.run.dir;
+      for (int seed = 1; seed <= seeds && !interrupted_by_signal(); ++seed) {
+        ClosedLoopRun run = e.run;
+        if (seeds > 1) {
+          run.dir = e.run.dir / ("seed-" + std::to_string(seed));
+          run.extra_args["seed"] = std::to_string(seed);
+          run.notes +=
+              (run.notes.empty() ? "" : "; ") + std::string("seed ") + std::to_string(seed);
+          std::cerr << "== " << e.name << ": seed " << seed << " of " << seeds << "\n";
+        }
+        const ClosedLoopOutcome outcome = run_closed_loop(run, std::cerr);
+        if (outcome.status != 0) status = outcome.status;
+        try {
+          const report::Report r = report::make_report(run.dir);
+          for (const auto& failed : r.plots.failed) {
+            std::cerr << "FAILED figure " << failed.png << ": " << failed.reason << "\n";
+            status = 1;
+          }
+          per_seed.push_back(r.summary);
+          if (seed == 1) index_dir = run.dir;
+        } catch (const std::exception& ex) {
+          std::cerr << "avs experiments: " << e.name << ": no report: " << ex.what() << "\n";
           status = 1;
         }
-        const std::string table = report::format_comparison_table(e.run.scenario, r.summary);
-        (json ? std::cerr : std::cout)
-            << "\n"
-            << e.name << " (Sec. " << e.section << ", " << e.run.dir.string() << "/index.html)\n"
-            << table << report::format_run_clocks(r.summary) << "\n\n";
-        markdown += "## " + e.name + " (Sec. " + e.section + ")\n\n" + e.what + ". Report: `" +
-                    (e.run.dir / "index.html").string() + "`.\n\n" +
-                    report::format_comparison_markdown(e.run.scenario, r.summary) + "\n" +
-                    report::format_run_clocks(r.summary) + "\n\n";
-        summaries.emplace_back(e.name, r.summary);
-      } catch (const std::exception& ex) {
-        std::cerr << "avs experiments: " << e.name << ": no report: " << ex.what() << "\n";
-        status = 1;
+      }
+      if (per_seed.empty()) continue;
+      {
+        const report::SeedSpread spread = report::across_seeds(per_seed);
+        const report::Summary& summary = spread.median;
+        const std::string seeds_note =
+            seeds > 1 ? "median of " + std::to_string(per_seed.size()) + " seeds; " : "";
+        const std::string table = report::format_comparison_table(e.run.scenario, summary);
+        (json ? std::cerr : std::cout) << "\n"
+                                       << e.name << " (Sec. " << e.section << ", " << seeds_note
+                                       << index_dir.string() << "/index.html)\n"
+                                       << table << report::format_run_clocks(summary) << "\n";
+        if (seeds > 1) (json ? std::cerr : std::cout) << report::format_seed_spread(spread);
+        (json ? std::cerr : std::cout) << "\n";
+        markdown += "## " + e.name + " (Sec. " + e.section + ")\n\n" + e.what + ". " +
+                    (seeds > 1 ? "Median of " + std::to_string(per_seed.size()) + " seeds. " : "") +
+                    "Report: `" + (index_dir / "index.html").string() + "`.\n\n" +
+                    report::format_comparison_markdown(e.run.scenario, summary) + "\n" +
+                    (seeds > 1 ? report::format_seed_spread(spread, true) + "\n" : "") +
+                    report::format_run_clocks(summary) + "\n\n";
+        summaries.emplace_back(e.name, summary);
       }
     }
     const std::string json_text = report::experiments_json(summaries);
