@@ -1,6 +1,7 @@
 // Sensor effects (issue 19 item 1) against their closed forms: each effect is switched on alone
 // on a plane facing the camera, and the rendered image is compared with what the effect's
 // formula predicts from the renderer's ground truth (projector row, depth), not from its code.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -105,6 +106,55 @@ TEST(SensorEffects, BlurSigmaFollowsTheThinLens) {
   EXPECT_NEAR(optics.blur_sigma_px(2.0, 1000), 0.5, 1e-12);
   optics.focused_blur_px = 0.5;
   EXPECT_NEAR(optics.blur_sigma_px(2.0, 1000), std::sqrt(0.5), 1e-12);
+}
+
+TEST(SensorEffects, CameraDefocusBlursByTheThinLensSigmaAtEachDepth) {
+  RendererConfig sharp = quiet();
+  RendererConfig defocused = sharp;
+  defocused.effects.lens.f_number = 1.4;  // wide open, to see it
+  defocused.effects.lens.focus_distance_m = 1.0;
+  const geometry::Mesh plane = geometry::make_plane(4.0, 4.0, 1);
+  const auto render = [&](const RendererConfig& c) {
+    Renderer r(c);
+    r.set_view({facing_plane(plane, 0.5)});  // well in front of the focus
+    MonoImage image;
+    r.shade(6, true, 1, image);  // stripes 8 codes wide: edges along the image rows
+    return image;
+  };
+  const MonoImage a = render(sharp), b = render(defocused);
+  // The expected blur from the thin lens: (f / N) f |d - focus| / (d (focus - f)) on the sensor.
+  const double f = 0.006, fx = sharp.geometry.camera.fx_px;
+  const double disc_m = (f / 1.4) * f * 0.5 / (0.5 * (1.0 - f));
+  const double sigma = disc_m * fx / f / 4.0;
+  EXPECT_NEAR(defocused.effects.lens.blur_sigma_px(0.5, fx), sigma, 1e-12);
+  ASSERT_GT(sigma, 0.5);
+  // Blur the sharp image with that Gaussian (separable, radius 3, clamped borders) in double.
+  const int w = a.width, h = a.height;
+  std::vector<double> tmp(a.pixels.size()), expected(a.pixels.size());
+  const auto weight = [&](int t) { return std::exp(-0.5 * t * t / (sigma * sigma)); };
+  double norm = 0;
+  for (int t = -3; t <= 3; ++t) norm += weight(t);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      double sum = 0;
+      for (int t = -3; t <= 3; ++t) sum += weight(t) * a.at(std::clamp(x + t, 0, w - 1), y);
+      tmp[static_cast<std::size_t>(y) * w + x] = sum / norm;
+    }
+  }
+  double worst = 0, largest_change = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      double sum = 0;
+      for (int t = -3; t <= 3; ++t) {
+        sum += weight(t) * tmp[static_cast<std::size_t>(std::clamp(y + t, 0, h - 1)) * w + x];
+      }
+      worst = std::max(worst, std::abs(sum / norm - b.at(x, y)));
+      largest_change = std::max(largest_change, std::abs(double(a.at(x, y)) - b.at(x, y)));
+    }
+  }
+  EXPECT_GT(largest_change, 20) << "a visible blur at the stripe edges";
+  // The sharp image's rounding, the blurred one's and the 1/16 px sigma levels.
+  EXPECT_LE(worst, 1.6);
 }
 
 TEST(SensorEffects, BlackLevelLightsTheDarkStripes) {
@@ -291,12 +341,14 @@ TEST(SensorProfile, NamesAndValues) {
   apply_sensor_profile(SensorProfile::kRealistic, c);
   EXPECT_TRUE(c.renderer.effects.changes_pattern_light());
   EXPECT_FALSE(c.renderer.effects.camera.is_ideal());
+  EXPECT_TRUE(c.renderer.effects.lens.blurs());
   EXPECT_GT(c.motion_blur_samples, 1);
   EXPECT_EQ(c.renderer.effects.problem(), "");
   apply_sensor_profile(SensorProfile::kIdeal, c);
   const SimulatorConfig defaults;
   EXPECT_FALSE(c.renderer.effects.changes_pattern_light());
   EXPECT_TRUE(c.renderer.effects.camera.is_ideal());
+  EXPECT_FALSE(c.renderer.effects.lens.blurs());
   EXPECT_EQ(c.motion_blur_samples, defaults.motion_blur_samples);
   EXPECT_EQ(c.renderer.noise_sigma_dn, defaults.renderer.noise_sigma_dn);
 }

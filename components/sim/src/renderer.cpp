@@ -215,6 +215,29 @@ void Renderer::set_up_effects(const geometry::CameraModel& pinhole) {
       phi_table_[k] = static_cast<float>(0.5 * std::erfc(-z / std::numbers::sqrt2));
     }
   }
+  if (e.lens.blurs()) {
+    // Gaussian weights per sigma level (level / kBlurLevelsPerPixel px), normalised over the
+    // kernel; level 0 is the identity.
+    const std::size_t camera_pixels =
+        static_cast<std::size_t>(config_.geometry.camera.width) * config_.geometry.camera.height;
+    blur_level_.assign(camera_pixels, 0);
+    constexpr int kTaps = 2 * kBlurRadius + 1;
+    blur_weights_.assign(static_cast<std::size_t>(kBlurLevels) * kTaps, 0.0f);
+    for (int level = 0; level < kBlurLevels; ++level) {
+      float* k = blur_weights_.data() + static_cast<std::size_t>(level) * kTaps;
+      const double sigma = static_cast<double>(level) / kBlurLevelsPerPixel;
+      if (level == 0) {
+        k[kBlurRadius] = 1.0f;
+        continue;
+      }
+      double sum = 0;
+      for (int t = -kBlurRadius; t <= kBlurRadius; ++t)
+        sum += std::exp(-0.5 * t * t / (sigma * sigma));
+      for (int t = -kBlurRadius; t <= kBlurRadius; ++t) {
+        k[t + kBlurRadius] = static_cast<float>(std::exp(-0.5 * t * t / (sigma * sigma)) / sum);
+      }
+    }
+  }
   camera_response_ = !e.camera.is_ideal();
   if (!camera_response_) return;
   const CameraResponse& c = e.camera;
@@ -528,6 +551,21 @@ void Renderer::set_view(const std::vector<RenderObject>& objects) {
   }
   camera_box_ = new_camera_box_;
   shadow_box_ = new_shadow_box_;
+  if (!blur_level_.empty()) update_blur_levels();
+}
+
+void Renderer::update_blur_levels() {
+  // Each camera pixel's defocus from the depth it sees (its nearest pinhole pixel with lens
+  // distortion); nothing seen: a point at infinity.
+  const CameraOptics& lens = config_.effects.lens;
+  const double fx = config_.geometry.camera.fx_px;
+  const float* inv_depth = camera_buffer_.inv_depth.data();
+  for (std::size_t i = 0; i < blur_level_.size(); ++i) {
+    const std::size_t p = remap_.empty() ? i : remap_[i].nearest;
+    const double z = inv_depth[p] > 0 ? 1.0 / inv_depth[p] : 0.0;
+    const double level = std::round(lens.blur_sigma_px(z, fx) * kBlurLevelsPerPixel);
+    blur_level_[i] = static_cast<std::uint8_t>(std::min(level, double{kBlurLevels - 1}));
+  }
 }
 
 bool Renderer::row_reads_shadow_cells(int y, const Box& cells) const {
@@ -844,7 +882,22 @@ void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) 
   const std::int8_t* noise = noise_bank_.data() + offset;
   const float sigma = static_cast<float>(config_.noise_sigma_dn) / kNoiseBankScale;
   std::uint8_t* pixels = out.pixels.data();
-  if (camera_response_) {
+  // The light reaching camera pixel i: the pinhole's, remapped with lens distortion.
+  const auto light_at = [&](std::size_t i) {
+    if (remap_.empty()) return value(i);
+    const RemapEntry& e = remap_[i];
+    return e.weight[0] * value(e.index[0]) + e.weight[1] * value(e.index[1]) +
+           e.weight[2] * value(e.index[2]) + e.weight[3] * value(e.index[3]);
+  };
+  // Light (DN) to pixel values: the camera's response with its noise, or the plain Gaussian.
+  const auto expose = [&](auto light) {
+    if (!camera_response_) {
+      for (std::size_t i = 0; i < n; ++i) {
+        const float v = light(i) + sigma * static_cast<float>(noise[i]) + 0.5f;
+        pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), kFullScaleDn));
+      }
+      return;
+    }
     // EMVA 1288's linear camera: gain and offset non-uniformity, then temporal noise of
     // variance signal / (e-/DN) + read noise^2 (+ the plain Gaussian noise), then the response
     // curve. The noise bank holds N(0, 1) x 32.
@@ -854,15 +907,7 @@ void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) 
     const float* dsnu = dsnu_dn_.data();
     const float* gamma = gamma_table_.empty() ? nullptr : gamma_table_.data();
     for (std::size_t i = 0; i < n; ++i) {
-      float light = 0;
-      if (remap_.empty()) {
-        light = value(i);
-      } else {
-        const RemapEntry& e = remap_[i];
-        light = e.weight[0] * value(e.index[0]) + e.weight[1] * value(e.index[1]) +
-                e.weight[2] * value(e.index[2]) + e.weight[3] * value(e.index[3]);
-      }
-      const float signal = light * prnu[i] + dsnu[i];
+      const float signal = light(i) * prnu[i] + dsnu[i];
       const float variance = std::max(signal, 0.0f) * per_electron + read_variance + fixed_variance;
       float v = signal + std::sqrt(variance) * static_cast<float>(noise[i]) / kNoiseBankScale;
       if (gamma != nullptr) {
@@ -873,21 +918,65 @@ void Renderer::quantise(std::uint64_t noise_key, ValueFn value, MonoImage& out) 
       }
       pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v + 0.5f, 0.0f), kFullScaleDn));
     }
+  };
+  if (!blur_level_.empty()) {
+    // Camera defocus: the light image blurred by each pixel's own Gaussian, then exposed.
+    blur_in_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) blur_in_[i] = light_at(i);
+    defocus_camera_image();
+    expose([&](std::size_t i) { return blur_in_[i]; });
     return;
   }
-  if (remap_.empty()) {
-    for (std::size_t i = 0; i < n; ++i) {
-      const float v = value(i) + sigma * static_cast<float>(noise[i]) + 0.5f;
-      pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), kFullScaleDn));
-    }
+  if (camera_response_ || !remap_.empty()) {
+    expose(light_at);
     return;
   }
-  for (std::size_t i = 0; i < n; ++i) {  // lens distortion: the pinhole's light, remapped
-    const RemapEntry& e = remap_[i];
-    const float light = e.weight[0] * value(e.index[0]) + e.weight[1] * value(e.index[1]) +
-                        e.weight[2] * value(e.index[2]) + e.weight[3] * value(e.index[3]);
-    const float v = light + sigma * static_cast<float>(noise[i]) + 0.5f;
+  for (std::size_t i = 0; i < n; ++i) {  // the ideal camera: one vectorised loop
+    const float v = value(i) + sigma * static_cast<float>(noise[i]) + 0.5f;
     pixels[i] = static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), kFullScaleDn));
+  }
+}
+
+void Renderer::defocus_camera_image() const {
+  // Separable gather: each output pixel weighs its neighbours with the Gaussian of its own
+  // depth's sigma (blur_level_: per camera pixel, kBlurLevelsPerPixel levels per pixel of
+  // sigma, kernel radius kBlurRadius); borders repeat the edge pixel.
+  const int w = width(), h = height();
+  blur_tmp_.resize(blur_in_.size());
+  const float* weights = blur_weights_.data();
+  constexpr int kTaps = 2 * kBlurRadius + 1;
+  const auto kernel = [&](std::size_t i) {
+    return weights + static_cast<std::size_t>(blur_level_[i]) * kTaps;
+  };
+  for (int y = 0; y < h; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    const float* in = blur_in_.data() + row;
+    float* out = blur_tmp_.data() + row;
+    for (int x = 0; x < w; ++x) {
+      const float* k = kernel(row + x);
+      float sum = 0;
+      if (x >= kBlurRadius && x + kBlurRadius < w) {
+        for (int t = 0; t < kTaps; ++t) sum += k[t] * in[x - kBlurRadius + t];
+      } else {
+        for (int t = 0; t < kTaps; ++t) sum += k[t] * in[std::clamp(x - kBlurRadius + t, 0, w - 1)];
+      }
+      out[x] = sum;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * w;
+    const float* rows[kTaps];
+    for (int t = 0; t < kTaps; ++t) {
+      rows[t] = blur_tmp_.data() +
+                static_cast<std::size_t>(std::clamp(y - kBlurRadius + t, 0, h - 1)) * w;
+    }
+    float* out = blur_in_.data() + row;
+    for (int x = 0; x < w; ++x) {
+      const float* k = kernel(row + x);
+      float sum = 0;
+      for (int t = 0; t < kTaps; ++t) sum += k[t] * rows[t][x];
+      out[x] = sum;
+    }
   }
 }
 

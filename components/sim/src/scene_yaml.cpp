@@ -204,13 +204,18 @@ class Parser {
     c.motion_blur_samples = get(node, "motion_blur_samples", c.motion_blur_samples);
   }
 
-  /// sensor.projector, .camera, .ambient_flicker and .surface: single effect values.
+  /// sensor.projector, .lens, .camera, .ambient_flicker and .surface: single effect values.
   void effects(const YAML::Node& node, SensorEffects& e) const {
     if (const YAML::Node p = node["projector"]) {
       e.projector.black_level = get(p, "black_level", e.projector.black_level);
       e.projector.aperture_m = get(p, "aperture_m", e.projector.aperture_m);
       e.projector.focus_distance_m = get(p, "focus_distance_m", e.projector.focus_distance_m);
       e.projector.focused_blur_px = get(p, "focused_blur_px", e.projector.focused_blur_px);
+    }
+    if (const YAML::Node l = node["lens"]) {
+      e.lens.f_number = get(l, "f_number", e.lens.f_number);
+      e.lens.focus_distance_m = get(l, "focus_distance_m", e.lens.focus_distance_m);
+      e.lens.focal_length_m = get(l, "focal_length_m", e.lens.focal_length_m);
     }
     if (const YAML::Node m = node["camera"]) {
       e.camera.full_well_e = get(m, "full_well_e", e.camera.full_well_e);

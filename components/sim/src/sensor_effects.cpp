@@ -53,6 +53,15 @@ double ProjectorOptics::blur_sigma_px(double depth_m, double focal_px) const {
   return std::sqrt(defocus_px * defocus_px + focused_blur_px * focused_blur_px);
 }
 
+double CameraOptics::blur_sigma_px(double depth_m, double focal_px) const {
+  if (!blurs()) return 0.0;
+  const double f = focal_length_m, aperture_m = f / f_number;
+  // |d - focus| / d, and its limit 1 for a point at infinity.
+  const double defocus = depth_m > 0 ? std::abs(depth_m - focus_distance_m) / depth_m : 1.0;
+  const double disc_m = aperture_m * f * defocus / (focus_distance_m - f);
+  return disc_m * focal_px / f / 4.0;  // pitch = f / focal_px
+}
+
 double AmbientFlicker::mean_gain(double time_s, double exposure_s) const {
   if (modulation == 0) return 1.0;
   const double w = 2 * std::numbers::pi * frequency_hz;
@@ -79,6 +88,11 @@ std::string SensorEffects::problem() const {
   if (!(projector.focus_distance_m > 0) || !std::isfinite(projector.focus_distance_m))
     return "projector focus_distance_m must be > 0";
   if (bad(projector.focused_blur_px)) return "projector focused_blur_px must be >= 0";
+  if (bad(lens.f_number)) return "lens f_number must be >= 0";
+  if (!(lens.focal_length_m > 0) || !std::isfinite(lens.focal_length_m))
+    return "lens focal_length_m must be > 0";
+  if (!(lens.focus_distance_m > lens.focal_length_m) || !std::isfinite(lens.focus_distance_m))
+    return "lens focus_distance_m must be beyond the focal length";
   if (bad(camera.full_well_e)) return "camera full_well_e must be >= 0";
   if (bad(camera.read_noise_e)) return "camera read_noise_e must be >= 0";
   if (camera.read_noise_e > 0 && camera.full_well_e == 0)

@@ -34,6 +34,11 @@ void apply_sensor_profile(SensorProfile profile, SimulatorConfig& config) {
   e.projector.aperture_m = 0.004;      // our estimate (pico projector lens, about f/2)
   e.projector.focus_distance_m = 1.0;  // issue 19: focused at 1 m, the middle of 0.5-2 m
   e.projector.focused_blur_px = 0.5;   // our estimate (lens resolution at the DMD pitch)
+  // Camera lens: Table 2's 6 mm lens at f/2 (our choice: open for light at 1 ms exposures),
+  // focused at 1 m like the projector.
+  e.lens.f_number = 2.0;
+  e.lens.focus_distance_m = 1.0;
+  e.lens.focal_length_m = 0.006;
   // Camera: Photron IDP-Express (Table 2); its sensor's EMVA 1288 figures are not published,
   // these are typical of 10 um high-speed CMOS pixels.
   e.camera.full_well_e = 12000;

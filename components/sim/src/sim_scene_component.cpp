@@ -184,7 +184,8 @@ class SimScene final : public runtime::Component {
                ctx.uses_sim_time() ? "simulated" : "wall", " clock, noise ",
                c.renderer.noise_sigma_dn, " DN seed ", c.renderer.noise_seed, ", blur samples ",
                c.motion_blur_samples, ", ",
-               c.renderer.effects.changes_pattern_light() || !c.renderer.effects.camera.is_ideal()
+               c.renderer.effects.changes_pattern_light() ||
+                       !c.renderer.effects.camera.is_ideal() || c.renderer.effects.lens.blurs()
                    ? "optics and sensor effects on (docs/sim.md)"
                    : "ideal optics and sensor");
   }

@@ -248,6 +248,16 @@ class Renderer {
   std::vector<float> prnu_gain_, dsnu_dn_;                   ///< per camera pixel, fixed pattern
   float dn_per_electron_ = 0, read_variance_dn2_ = 0;
   std::vector<float> gamma_table_;  ///< 255 (s / 255)^(1 / gamma) at s = k / 4, k = 0..1024
+  // Camera defocus (effects.lens): per camera pixel a sigma level, Gaussian kernels per level.
+  static constexpr int kBlurRadius = 3;
+  static constexpr int kBlurLevelsPerPixel = 16;
+  static constexpr int kBlurLevels = 2 * kBlurLevelsPerPixel + 1;  ///< sigma 0 .. 2 px
+  std::vector<std::uint8_t> blur_level_;                           ///< empty: no camera defocus
+  std::vector<float> blur_weights_;
+  mutable std::vector<float> blur_in_, blur_tmp_;  ///< per-frame scratch of quantise()
+  void update_blur_levels();
+  /// Blurs blur_in_ in place by each pixel's level.
+  void defocus_camera_image() const;
 };
 
 /// The noise key of a frame: mixes the frame index so consecutive frames are independent.

@@ -53,6 +53,19 @@ struct CameraResponse {
   }
 };
 
+/// The camera lens's defocus (thin lens): the image of a point at depth d is a disc of diameter
+/// (f / N) f |d - focus| / (d (focus - f)) on the sensor.
+struct CameraOptics {
+  double f_number = 0.0;  ///< N; 0: a pinhole (everything sharp)
+  double focus_distance_m = 1.0;
+  double focal_length_m = 0.006;  ///< Table 2's 6 mm lens; the pixel pitch is this / fx_px
+
+  bool blurs() const { return f_number > 0; }
+  /// Gaussian sigma in camera pixels at depth `depth_m` (0 or less: infinitely far) for a camera
+  /// of focal length `focal_px` (sigma = disc / 4).
+  double blur_sigma_px(double depth_m, double focal_px) const;
+};
+
 /// Room light on mains power flickers at twice the mains frequency.
 struct AmbientFlicker {
   /// Ambient light = ambient_level x (1 + modulation x sin(2 pi frequency_hz t)); 0: steady.
@@ -81,6 +94,7 @@ struct SurfaceEffects {
 
 struct SensorEffects {
   ProjectorOptics projector;
+  CameraOptics lens;
   CameraResponse camera;
   AmbientFlicker ambient;
   SurfaceEffects surface;
