@@ -86,6 +86,7 @@ TEST(BorderRegions, MarksWhatTouchesTheBorderThroughSmoothDepth) {
   EXPECT_EQ(keep[5 * kW + 3], 0) << "board";
   EXPECT_EQ(keep[20 * kW + 20], 1) << "target beside the board";
   EXPECT_EQ(keep[20 * kW + 50], 1) << "outside the window: not marked";
+  EXPECT_NEAR(regions.depth_separation_m(), 1.0F - 0.61F, 0.011F) << "board 0.6-0.62, target 1.0";
   // A smooth ramp from the board into the target joins them.
   for (int u = 20; u < 30; ++u)
     depth[static_cast<std::size_t>(20) * kW + u] = 0.62F + 0.01F * (u - 20);

@@ -1,7 +1,9 @@
 // Border-connected depth regions; see border_regions.hpp.
 #include "avs/matching/border_regions.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace avs::matching {
 
@@ -46,6 +48,23 @@ std::size_t BorderRegions::mark(const DepthView& depth, float min_depth_m, float
       stack_.push_back(static_cast<std::int32_t>(n));
     }
   }
+  marked_z_.clear();
+  kept_z_.clear();
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const float z = z_at(u, v);
+      if (!in_window(z)) continue;
+      (keep_[static_cast<std::size_t>(v) * w + u] ? kept_z_ : marked_z_).push_back(z);
+    }
+  }
+  const auto median = [](std::vector<float>& z) {
+    const auto middle = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2);
+    std::nth_element(z.begin(), middle, z.end());
+    return *middle;
+  };
+  separation_m_ = marked_z_.empty() || kept_z_.empty()
+                      ? std::numeric_limits<float>::quiet_NaN()
+                      : std::abs(median(marked_z_) - median(kept_z_));
   return marked;
 }
 

@@ -98,13 +98,14 @@ class MatchingComponent final : public runtime::Component {
                           "scene_points", "/object/scene_points", best_effort_2),
                       runtime::port<msgs::sensor_msgs::PointCloud2>(
                           "model_points", "/object/model_points", best_effort_2)},
-        .subscribes =
-            {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image", keep_last_4),
-             runtime::port<msgs::sensor_msgs::JointState>("joint_states", "/head/joint_states",
-                                                          joint_history),
-             runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info", keep_last_4),
-             runtime::port<msgs::sensor_msgs::CameraInfo>("camera_info", "/depth/camera_info",
-                                                          msg::camera_info_qos())},
+        .subscribes = {runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image",
+                                                               keep_last_4),
+                       runtime::port<msgs::sensor_msgs::JointState>(
+                           "joint_states", "/head/joint_states", joint_history),
+                       runtime::port<msgs::avs_msgs::DepthInfo>("depth_info", "/depth/info",
+                                                                keep_last_4),
+                       runtime::port<msgs::sensor_msgs::CameraInfo>(
+                           "camera_info", "/depth/camera_info", msg::camera_info_qos())},
         .default_mismatches = [] { return params().default_mismatches(); }};
   }
 

@@ -114,9 +114,12 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
   MaskView mask;
   if (out.truncated && config_.min_pixels_beside_border_clutter > 0) {
     // Clutter that enters from the side: match what is not connected to the border, if enough.
-    out.border_clutter_pixels = border_regions_.mark(
+    const std::size_t clutter = border_regions_.mark(
         depth, config_.depth_min_m, config_.depth_max_m, config_.border_region_step_m);
-    mask.mask = border_regions_.keep_mask();
+    if (border_regions_.depth_separation_m() >= config_.border_clutter_min_separation_m) {
+      out.border_clutter_pixels = clutter;
+      mask.mask = border_regions_.keep_mask();
+    }
   }
   scene_ = &builder_.build(depth, mask, config_.camera);
   out.valid_pixels = builder_.valid_pixels();

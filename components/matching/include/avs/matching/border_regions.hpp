@@ -21,8 +21,15 @@ class BorderRegions {
   /// keep), valid until the next call.
   std::size_t mark(const DepthView& depth, float min_depth_m, float max_depth_m, float max_step_m);
   const std::uint8_t* keep_mask() const { return keep_.data(); }
+  /// |median depth of the marked pixels - median depth of the other depth-window pixels| of
+  /// the last mark(), NaN when either set is empty. An occluder in front of the target (or
+  /// clutter behind it) is far from the target's depth; a target that is itself cut by the
+  /// border, with some of its parts split off by depth steps, is not.
+  float depth_separation_m() const { return separation_m_; }
 
  private:
+  float separation_m_ = 0.0F;
+  std::vector<float> marked_z_, kept_z_;  ///< scratch for the medians
   std::vector<std::uint8_t> keep_;
   std::vector<std::int32_t> stack_;  ///< flood-fill scratch, kept between frames
 };
