@@ -165,11 +165,45 @@ TEST_F(IcpOnKen, ZeroIterationsOnlyEvaluates) {
   EXPECT_GT(off.rmse_m, at_truth.rmse_m);
 }
 
+// Issue 19, clutter: a hand in front of a third of the ken pulls plain ICP toward the camera;
+// the trimmed ICP leaves the hand's pairs out (they are far beyond the median pair distance).
+TEST_F(IcpOnKen, TrimmedIcpIsNotPulledByAHandInFrontOfTheTarget) {
+  // The closed loop's setting: the dense surface samples with 15 mm pairs.
+  const Points held = test::with_hand(scene_, 0.012F, 0.35F);
+  IcpConfig config;
+  config.iterations = {0, 0, 20};
+  config.metric = IcpMetric::point_to_plane;
+  config.max_correspondence_distance_m = 0.015F;
+  Icp plain(model_.dense_points_m, config, model_.dense_normals);
+  config.trim_factor = 2.5F;
+  Icp trimmed(model_.dense_points_m, config, model_.dense_normals);
+  const PoseError plain_error =
+      pose_error(plain.align(held, guess_).T_camera_model, truth_, Symmetry::none);
+  const IcpResult trimmed_result = trimmed.align(held, guess_);
+  const PoseError trimmed_error = pose_error(trimmed_result.T_camera_model, truth_, Symmetry::none);
+  std::printf(
+      "hand in front of 35 %% of the ken: plain %.2f mm %.2f deg, trimmed %.2f mm %.2f deg\n",
+      1e3 * plain_error.translation_m, plain_error.rotation_deg, 1e3 * trimmed_error.translation_m,
+      trimmed_error.rotation_deg);
+  EXPECT_GT(plain_error.translation_m, 0.002F);
+  EXPECT_LT(trimmed_error.translation_m, 0.001F);
+  EXPECT_LT(trimmed_error.rotation_deg, 1.0F);
+  // The hand's pairs are trimmed, not the ken's: about 65 % of the scene is paired.
+  EXPECT_NEAR(static_cast<double>(trimmed_result.correspondences) / held.size(), 0.65, 0.08);
+  // Without clutter the trimmed ICP lands where the plain one does.
+  const PoseError clean_plain =
+      pose_error(plain.align(scene_, guess_).T_camera_model, truth_, Symmetry::none);
+  const PoseError clean_trimmed =
+      pose_error(trimmed.align(scene_, guess_).T_camera_model, truth_, Symmetry::none);
+  EXPECT_NEAR(clean_trimmed.translation_m, clean_plain.translation_m, 0.0005F);
+}
+
 TEST_F(IcpOnKen, PerFrameAlignDoesNotAllocate) {
   for (const auto metric : {IcpMetric::point_to_point, IcpMetric::point_to_plane}) {
     IcpConfig config;
     config.metric = metric;
     config.iterations = {1, 1, 1};
+    config.trim_factor = 2.5F;  // trimming reuses its buffers too
     Icp icp(model_.points_m, config, model_.normals);
     icp.align(scene_, guess_);  // warm-up
     const long before = g_allocations.load();

@@ -100,6 +100,52 @@ TEST(InitialAlignment, VerificationPrefersTheTruePoseOverTheFlip) {
   EXPECT_EQ(better, kSeeds);
 }
 
+// Issue 19, clutter: a hand (a flat face) in front of a third of the ken. The hand's points cost
+// the true pose as much as any other, and they pull the refining ICP, so the plain aligner lets
+// poses that half-fit the hand win: 0 of 20. The trimmed ICP and the scene term over the best
+// 60 % of the points find the ken in 11 of 20. In each of the other 9 the true pose scores
+// better than the one chosen, but no hypothesis near it reaches the verification: the LRF
+// hypotheses are the limit (docs/matching.md, clutter). Without the hand the trimmed aligner
+// finds 18 of 20 against the plain one's 20, which is why trimming is off by default.
+TEST(InitialAlignment, TrimmedScoringFindsTheKenHeldInAHandMoreOften) {
+  const ObjectPreset ken = builtin_objects()[0];
+  const ModelCloud model = test::model_of(ken);
+  InitialAlignmentConfig trimmed_config;
+  trimmed_config.trim_factor = 2.5F;
+  trimmed_config.score_trim_fraction = 0.6F;
+  trimmed_config.score_truncation_m = 0.006F;
+  InitialAligner plain(model);
+  InitialAligner trimmed(model, trimmed_config);
+  int plain_successes = 0;
+  int trimmed_successes = 0;
+  int trimmed_clean_successes = 0;
+  int plain_clean_successes = 0;
+  constexpr int kSeeds = 20;
+  const auto success = [&](const InitialAlignmentResult& r, const Eigen::Isometry3f& truth) {
+    const PoseError e = pose_error(r.T_camera_model, truth, ken.symmetry);
+    return r.valid && e.translation_m < 0.005F && e.rotation_deg < 5.0F ? 1 : 0;
+  };
+  for (int k = 0; k < kSeeds; ++k) {
+    const auto seed = 5000U + static_cast<std::uint32_t>(k);
+    const Eigen::Isometry3f truth = random_object_pose(seed);
+    const Points clean = test::scene_of(ken, model, truth, seed);
+    const Points held = test::with_hand(clean, 0.012F, 0.35F);
+    plain_successes += success(plain.align(held), truth);
+    trimmed_successes += success(trimmed.align(held), truth);
+    trimmed_clean_successes += success(trimmed.align(clean), truth);
+    plain_clean_successes += success(plain.align(clean), truth);
+  }
+  std::printf(
+      "ken, %d poses: held in a hand plain %d, trimmed %d successes; without the hand plain %d, "
+      "trimmed %d\n",
+      kSeeds, plain_successes, trimmed_successes, plain_clean_successes, trimmed_clean_successes);
+  EXPECT_LE(plain_successes, 2);
+  EXPECT_GE(trimmed_successes, 9);
+  // On a clean scene trimming is not free (18 of 20 against 20): why it is off by default.
+  EXPECT_GE(plain_clean_successes, kSeeds - 1);
+  EXPECT_GE(trimmed_clean_successes, kSeeds - 3);
+}
+
 TEST(InitialAlignmentLrfs, ModelHasFeatureFramesWithOrthonormalAxes) {
   const ObjectPreset ken = builtin_objects()[0];
   const ModelCloud model = test::model_of(ken);

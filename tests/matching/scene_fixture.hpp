@@ -1,7 +1,10 @@
 // Shared test helpers: a built-in object's M-PCD and S-PCDs rendered at known poses.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
+#include <vector>
 
 #include "avs/matching/model_cloud.hpp"
 #include "avs/matching/scene_cloud.hpp"
@@ -45,6 +48,25 @@ inline Points scene_of(const ObjectPreset& object, const ModelCloud& model,
   add_depth_noise(depth, kDepthNoiseM, seed);
   SceneCloudBuilder builder(scene_config_of(object, model));
   return builder.build(depth.view(), {}, camera);
+}
+
+/// What a hand holding the object adds to its S-PCD: the scene points of one side of the
+/// object (y below the scene's `share` quantile) are hidden behind a flat face (a box's, facing
+/// the camera) `gap_m` in front of the nearest of them, one point on each of their camera rays.
+inline Points with_hand(const Points& scene, float gap_m, float share) {
+  std::vector<float> ys;
+  for (const auto& p : scene) ys.push_back(p.y());
+  std::sort(ys.begin(), ys.end());
+  const float below = ys[static_cast<std::size_t>(share * static_cast<float>(ys.size() - 1))];
+  float nearest_z = std::numeric_limits<float>::max();
+  for (const auto& p : scene) {
+    if (p.y() <= below) nearest_z = std::min(nearest_z, p.z());
+  }
+  const float face_z = nearest_z - gap_m;
+  Points out;
+  for (const auto& p : scene)
+    out.push_back(p.y() <= below ? Eigen::Vector3f(p * (face_z / p.z())) : p);
+  return out;
 }
 
 inline Eigen::Isometry3f perturbed(const Eigen::Isometry3f& pose, const Eigen::Vector3f& offset_m,

@@ -76,6 +76,10 @@ struct Setup {
   /// Issue 19 clutter: a hand-sized box (70 x 50 x 70 mm) round the middle of the ken's handle
   /// moves with the ken, hiding that part of it all the time.
   bool holder = false;
+  /// Trimmed ICP (per frame and in the initial alignment) and the initial alignment's trimmed
+  /// scene term (docs/matching.md, clutter), with min_initial_inlier_ratio 0.5 (the hand hides
+  /// 44 % of the S-PCD, so a right initial pose aligns at 0.56).
+  bool trimmed = false;
 };
 
 /// A pose fixed in a moving object's frame (what a hand holding the object does).
@@ -170,6 +174,13 @@ Run run(const Setup& setup) {
     config.scene.voxel_size_m = 0.005F;
     config.scene.outlier_neighbours = 8;
     config.tracker.icp.iterations = {0, 0, 2};
+  }
+  if (setup.trimmed) {
+    config.tracker.icp.trim_factor = 2.5F;
+    config.tracker.initial.trim_factor = 2.5F;
+    config.tracker.initial.score_trim_fraction = 0.6F;
+    config.tracker.initial.score_truncation_m = 0.006F;
+    config.tracker.min_initial_inlier_ratio = 0.5F;
   }
   config.lag_compensation_s = setup.lag_compensation_s;
   config.velocity_window_s = setup.velocity_window_s;
@@ -419,12 +430,19 @@ TEST(SimAccuracy, KenBehindACrossingBoardIsLostThenReacquired) {
 // Issue 19 clutter: the ken held by a hand-sized box round its handle all the time. The box is
 // inside the depth window and touches the ken, so it is part of the scene cloud: matching must
 // still never flip and keep the goals. NOT MET, so disabled (gtest lists it as disabled on every
-// run; run it with --gtest_also_run_disabled_tests): 52.9 mm / 75 deg RMS, 494 flips. The
-// initial alignment takes the box's front face for the ken's (15.6 mm towards the camera, 18
-// deg) and the per-frame ICP, whose 15 mm pairs then reach the box, drifts from there
-// (docs/matching.md, "Clutter that moves with the target").
+// run; run it with --gtest_also_run_disabled_tests; docs/matching.md, "Clutter that moves with
+// the target"). Plain: the initial alignment takes the box's front face for the ken's (16 mm
+// towards the camera, 19 deg) and the per-frame ICP, whose 15 mm pairs reach the box, drifts
+// from there: 52.9 mm / 75 deg RMS, 494 flips. Trimmed (as run here): the initial pose is right
+// (0.3 mm / 0.5 deg) and tracking holds it for 1.1 s; then the ken recedes at 1 m/s, the
+// rolling depth lags it by up to 12 mm, and the pose breaks away: 47.8 mm / 74.6 deg, 493 flips.
 TEST(SimAccuracy, DISABLED_KenHeldByAHandSizedBox) {
-  check({.object = "ken", .follow = true, .closed_loop_tuning = true, .holder = true}, 3.0, 2.0);
+  check({.object = "ken",
+         .follow = true,
+         .closed_loop_tuning = true,
+         .holder = true,
+         .trimmed = true},
+        3.0, 2.0);
 }
 // The plain decoder path: code centres, pose published as matched.
 TEST(SimAccuracy, KenWithCodeCentresAndNoAgeCompensation) {

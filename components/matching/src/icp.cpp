@@ -1,5 +1,6 @@
 #include "avs/matching/icp.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -79,16 +80,18 @@ Icp::Icp(Points model_points_m, IcpConfig config, Points model_normals)
 void Icp::reserve(std::size_t points) {
   source_.reserve(points);
   target_.reserve(points);
+  squared_.reserve(points);
+  median_scratch_.reserve(points);
 }
 
-std::size_t Icp::iterate(const Points& p_camera, std::size_t step,
-                         Eigen::Isometry3f& T_model_camera) {
+void Icp::pair_up(const Points& p_camera, std::size_t step,
+                  const Eigen::Isometry3f& T_model_camera) {
   // Eq. 21: closest model point y of every (sub-sampled) scene point p, in the model frame.
   const float max_squared =
       config_.max_correspondence_distance_m * config_.max_correspondence_distance_m;
-  const Points& model = tree_.points();
   source_.resize(p_camera.size());
   target_.resize(p_camera.size());
+  squared_.resize(p_camera.size());
   pairs_ = 0;
   for (std::size_t i = 0; i < p_camera.size(); i += step) {
     const Eigen::Vector3f p_model = T_model_camera * p_camera[i];
@@ -96,9 +99,17 @@ std::size_t Icp::iterate(const Points& p_camera, std::size_t step,
     if (squared > max_squared) continue;
     source_[pairs_] = p_model;
     target_[pairs_] = index;
+    squared_[pairs_] = squared;
     ++pairs_;
   }
+  trim();
+}
+
+std::size_t Icp::iterate(const Points& p_camera, std::size_t step,
+                         Eigen::Isometry3f& T_model_camera) {
+  pair_up(p_camera, step, T_model_camera);
   if (pairs_ < 3) return pairs_;
+  const Points& model = tree_.points();
 
   Eigen::Isometry3f update = Eigen::Isometry3f::Identity();
   if (config_.metric == IcpMetric::point_to_point) {
@@ -151,6 +162,26 @@ void Icp::evaluate(const Eigen::Isometry3f& /*T_model_camera*/, IcpResult& resul
   result.valid = pairs_ >= 3;
 }
 
+void Icp::trim() {
+  if (!(config_.trim_factor > 0.0F) || pairs_ < 6) return;
+  // The median pair distance: the target's own pairs are the majority, so it is the sensor's
+  // noise plus the guess's error; pairs far beyond it are another surface's.
+  median_scratch_.assign(squared_.begin(), squared_.begin() + static_cast<std::ptrdiff_t>(pairs_));
+  const auto middle = median_scratch_.begin() + static_cast<std::ptrdiff_t>(pairs_ / 2);
+  std::nth_element(median_scratch_.begin(), middle, median_scratch_.end());
+  const float limit_m = std::max(config_.trim_floor_m, config_.trim_factor * std::sqrt(*middle));
+  const float limit_squared = limit_m * limit_m;
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < pairs_; ++i) {
+    if (squared_[i] > limit_squared) continue;
+    source_[kept] = source_[i];
+    target_[kept] = target_[i];
+    squared_[kept] = squared_[i];
+    ++kept;
+  }
+  pairs_ = kept;
+}
+
 IcpResult Icp::align(const Points& p_camera, const Eigen::Isometry3f& T_camera_model_guess) {
   return align(p_camera, T_camera_model_guess, config_.iterations);
 }
@@ -171,18 +202,7 @@ IcpResult Icp::align(const Points& p_camera, const Eigen::Isometry3f& T_camera_m
   }
   if (result.iterations == 0) {
     // Evaluation only: pair every scene point with its closest model point, no update.
-    source_.resize(p_camera.size());
-    target_.resize(p_camera.size());
-    const float max_squared =
-        config_.max_correspondence_distance_m * config_.max_correspondence_distance_m;
-    for (const auto& p : p_camera) {
-      const Eigen::Vector3f p_model = T_model_camera * p;
-      const auto [index, squared] = tree_.nearest(p_model);
-      if (squared > max_squared) continue;
-      source_[pairs_] = p_model;
-      target_[pairs_] = index;
-      ++pairs_;
-    }
+    pair_up(p_camera, 1, T_model_camera);
   }
   evaluate(T_model_camera, result);
   result.T_camera_model = T_model_camera.inverse();

@@ -41,6 +41,7 @@ IcpConfig refine_config(const InitialAlignmentConfig& config) {
   icp.iterations = config.refine_iterations;
   icp.max_correspondence_distance_m = config.score_truncation_m;
   icp.metric = config.refine_metric;
+  icp.trim_factor = config.trim_factor;
   return icp;
 }
 
@@ -353,12 +354,25 @@ InitialAlignmentResult InitialAligner::align(const Points& p_camera) {
 }
 
 float InitialAligner::scene_distance(const Points& p_camera,
-                                     const Eigen::Isometry3f& T_model_camera) const {
-  // Mean truncated distance from the scene to the dense model surface (interpolated table).
+                                     const Eigen::Isometry3f& T_model_camera) {
+  // Mean truncated distance from the scene to the dense model surface (interpolated table),
+  // over the score_trim_fraction of the scene points closest to it.
+  distances_m_.resize(p_camera.size());
+  for (std::size_t i = 0; i < p_camera.size(); ++i) {
+    distances_m_[i] =
+        std::min(distance_.distance(T_model_camera * p_camera[i]), config_.verify_truncation_m);
+  }
+  const auto kept = std::clamp<std::size_t>(
+      static_cast<std::size_t>(
+          std::ceil(config_.score_trim_fraction * static_cast<float>(p_camera.size()))),
+      1, p_camera.size());
+  if (kept < p_camera.size()) {
+    std::nth_element(distances_m_.begin(), distances_m_.begin() + static_cast<std::ptrdiff_t>(kept),
+                     distances_m_.end());
+  }
   float sum = 0.0F;
-  for (const auto& p : p_camera)
-    sum += std::min(distance_.distance(T_model_camera * p), config_.verify_truncation_m);
-  return sum / static_cast<float>(p_camera.size());
+  for (std::size_t i = 0; i < kept; ++i) sum += distances_m_[i];
+  return sum / static_cast<float>(kept);
 }
 
 VerifiedPose InitialAligner::verify(const Points& p_camera,

@@ -133,6 +133,19 @@ class MatchingComponent final : public runtime::Component {
                   AVS_FIELD(pipeline.tracker.icp.max_correspondence_distance_m), 1e-4, 1.0, "m",
                   "per-frame ICP: scene points farther than this from their closest model point "
                   "are not used")
+            .real("icp_trim_factor", AVS_FIELD(pipeline.tracker.icp.trim_factor), 0.0, 100.0, "",
+                  "per-frame ICP: leave out pairs farther apart than this times the median pair "
+                  "distance (clutter beside the target; 0 = off, docs/matching.md)")
+            .real("initial_trim_factor", AVS_FIELD(pipeline.tracker.initial.trim_factor), 0.0,
+                  100.0, "", "initial alignment: the same trimming in its refining ICP (0 = off)")
+            .real("initial_score_trim_fraction",
+                  AVS_FIELD(pipeline.tracker.initial.score_trim_fraction), 0.05, 1.0, "",
+                  "initial alignment: score a pose by the mean distance of this share of the "
+                  "scene points closest to the model (1 = all)")
+            .real("initial_score_truncation_m",
+                  AVS_FIELD(pipeline.tracker.initial.score_truncation_m), 1e-4, 1.0, "m",
+                  "initial alignment: hypothesis distances are clamped to this, and its "
+                  "refining ICP pairs no farther")
             .real("max_rmse_m", AVS_FIELD(pipeline.tracker.max_rmse_m), 0.0, 1.0, "m",
                   "a frame fails above this ICP RMSE (0 = model's mean spacing)")
             .live()

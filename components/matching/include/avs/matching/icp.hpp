@@ -21,6 +21,13 @@ struct IcpConfig {
   float max_correspondence_distance_m = 0.03F;  ///< farther pairs are not used
   float inlier_distance_m = 0.0F;  ///< residual below this is an inlier; 0 = model's mean spacing
   std::size_t normal_neighbours = 10;  ///< for model normals (point-to-plane)
+  /// Trimmed ICP (issue 19, clutter): each iteration leaves out the pairs farther apart than
+  /// trim_factor x the median pair distance (and never below trim_floor_m), so a surface beside
+  /// the target (a hand holding it) does not pull the pose while the pairs of the target, whose
+  /// distances are the sensor's noise, all stay. 0 = off (every pair within
+  /// max_correspondence_distance_m is used).
+  float trim_factor = 0.0F;
+  float trim_floor_m = 0.003F;
 };
 
 struct IcpResult {
@@ -61,6 +68,10 @@ class Icp {
  private:
   // One iteration on every `step`-th scene point; updates T_model_camera. Returns pair count.
   std::size_t iterate(const Points& p_camera, std::size_t step, Eigen::Isometry3f& T_model_camera);
+  // Pairs every `step`-th scene point with its closest model point (then trims).
+  void pair_up(const Points& p_camera, std::size_t step, const Eigen::Isometry3f& T_model_camera);
+  // Trimming (IcpConfig::trim_factor): drops the far pairs of the current set.
+  void trim();
   void evaluate(const Eigen::Isometry3f& T_model_camera, IcpResult& result) const;
 
   KdTree tree_;
@@ -69,6 +80,8 @@ class Icp {
   float model_spacing_m_ = 0.0F;
   Points source_;                      // scene points in the model frame, paired ...
   std::vector<std::uint32_t> target_;  // ... with these model points
+  std::vector<float> squared_;         // ... at these squared distances (trimming)
+  std::vector<float> median_scratch_;  // nth_element's working copy of squared_
   std::size_t pairs_ = 0;
 };
 

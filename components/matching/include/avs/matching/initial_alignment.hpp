@@ -40,6 +40,12 @@ struct InitialAlignmentConfig {
   std::size_t verify_candidates = 3;
   IcpMetric refine_metric = IcpMetric::point_to_plane;
   float verify_truncation_m = 0.01F;  ///< truncation of the final scores
+  /// Trimmed ICP in the refinement and verification (IcpConfig::trim_factor; 0 = off).
+  float trim_factor = 0.0F;
+  /// The scene term of the screening and the verification is the mean over this share of the
+  /// scene points closest to the model (issue 19, clutter: a hand's points cost every
+  /// hypothesis, the true one too, and let a pose that fits the hand win); 1 = all points.
+  float score_trim_fraction = 1.0F;
   /// Weight of the visibility term: mean distance from the model points the refined pose shows
   /// to the camera to their closest scene points (self-occluded points count too; superseded
   /// by the free-space term, off by default).
@@ -129,7 +135,7 @@ class InitialAligner {
                                     const detail::RangeImage& range,
                                     const Eigen::Isometry3f& T_camera_model_guess);
   [[nodiscard]] float scene_distance(const Points& p_camera,
-                                     const Eigen::Isometry3f& T_model_camera) const;
+                                     const Eigen::Isometry3f& T_model_camera);
   [[nodiscard]] float score(const Points& p_camera, const std::vector<std::uint32_t>& subset,
                             const Eigen::Isometry3f& T_model_camera, float give_up_above) const;
 
@@ -146,6 +152,7 @@ class InitialAligner {
   std::vector<Lrf> scene_lrfs_used_;
   Icp refine_;
   Icp verify_;
+  std::vector<float> distances_m_;  // scene_distance's per-point distances (trimmed mean)
 };
 
 }  // namespace avs::matching
