@@ -113,8 +113,8 @@ TEST(CalibCommand, ClosedLoopWithTheRecoveredCalibrationDoesAsWellAsWithTheTruth
       0)
       << avs::testing::read_file(log) << avs::testing::read_file(err);
   const auto run_ken = [&](const std::vector<std::string>& calibration, const char* name) {
-    std::vector<std::string> words = {"experiments", "ken", "--json", "--out",
-                                      (dir / name).string()};
+    std::vector<std::string> words = {"experiments", "ken",   "--profile",          "ideal",
+                                      "--json",      "--out", (dir / name).string()};
     words.insert(words.end(), calibration.begin(), calibration.end());
     const fs::path json = dir / (std::string(name) + ".json");
     EXPECT_EQ(avs::testing::run_avs(words, json, err), 0) << avs::testing::read_file(err);

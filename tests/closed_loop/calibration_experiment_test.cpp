@@ -23,9 +23,10 @@ TEST(ClosedLoop, KenMeetsTheAccuracyGoalsWithANonDefaultCalibration) {
       fs::temp_directory_path() / ("avs-calibration-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string json_file = dir.string() + ".json";
-  const int status = avs::testing::run_avs({"experiments", "ken", "--json", "--calibration",
-                                            calibration.string(), "--out", dir.string()},
-                                           json_file, dir.string() + ".log");
+  const int status =
+      avs::testing::run_avs({"experiments", "ken", "--profile", "ideal", "--json", "--calibration",
+                             calibration.string(), "--out", dir.string()},
+                            json_file, dir.string() + ".log");
   const std::string json = avs::testing::read_file(json_file);
   const std::string log = avs::testing::read_file(dir.string() + ".log");
   ASSERT_EQ(status, 0) << json << log;

@@ -27,9 +27,9 @@ TEST(ClosedLoop, KenCubeAndCylinderOnTheManipulatorMeetTheAccuracyGoals) {
       fs::temp_directory_path() / ("avs-matching-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string json_file = dir.string() + ".json";
-  const int status = avs::testing::run_avs(
-      {"experiments", "ken", "cube", "cylinder", "--json", "--out", dir.string()}, json_file,
-      dir.string() + ".log");
+  const int status = avs::testing::run_avs({"experiments", "ken", "cube", "cylinder", "--profile",
+                                            "ideal", "--json", "--out", dir.string()},
+                                           json_file, dir.string() + ".log");
   const std::string json = avs::testing::read_file(json_file);
   ASSERT_EQ(status, 0) << json << avs::testing::read_file(dir.string() + ".log");
   for (const std::string object : {"ken", "cube", "cylinder"}) {

@@ -37,9 +37,9 @@ TEST(ClosedLoop, TrackingKeepsTheSwingingTargetInViewAndHoldingStillLosesIt) {
       fs::temp_directory_path() / ("avs-tracking-test-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string json_file = dir.string() + ".json";
-  const int status = avs::testing::run_avs(
-      {"experiments", "tracking", "no_tracking", "--json", "--out", dir.string()}, json_file,
-      dir.string() + ".log");
+  const int status = avs::testing::run_avs({"experiments", "tracking", "no_tracking", "--profile",
+                                            "ideal", "--json", "--out", dir.string()},
+                                           json_file, dir.string() + ".log");
   const std::string json = read_file(json_file);
   ASSERT_EQ(status, 0) << json << read_file(dir.string() + ".log");
 
@@ -54,6 +54,34 @@ TEST(ClosedLoop, TrackingKeepsTheSwingingTargetInViewAndHoldingStillLosesIt) {
   EXPECT_LE(on_rms, 20.0) << "issue 5 goal: centroid error RMS at most 20 px at 1 m/s";
   EXPECT_LT(off_in_view, 0.9) << "without tracking the swing must take the target out of view";
   EXPECT_GT(figure(json, "tracking", "depth_rate_hz"), 495.0);
+  fs::remove_all(dir);
+  fs::remove(json_file);
+  fs::remove(dir.string() + ".log");
+}
+
+// Issue 19, occlusion: a 0.25 x 0.4 m board crosses 0.6 m in front of the head, inside Eq. 8's
+// window, while the ken swings (launch_config/scenes/swing_occluded.yaml). With the paper's fixed
+// window the board joins the mask and the head turns to it: the ken is in view for 47 % of the
+// run (`avs launch launch_config/closed_loop.yaml scene:=swing_occluded depth_gate_m:=0 ...`).
+// With the depth gate of closed_loop.yaml the head holds while the ken is hidden (0.4 s) and
+// follows it again when it comes out: in view the whole run.
+TEST(ClosedLoop, TrackingKeepsTheKenNotThePassingBoardInView) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("avs-occlusion-test-" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  const std::string json_file = dir.string() + ".json";
+  const int status = avs::testing::run_avs(
+      {"experiments", "occlusion", "--profile", "ideal", "--json", "--out", dir.string()},
+      json_file, dir.string() + ".log");
+  const std::string json = read_file(json_file);
+  ASSERT_EQ(status, 0) << json << read_file(dir.string() + ".log");
+  const double in_view = figure(json, "occlusion", "in_view_fraction");
+  const double rms = figure(json, "occlusion", "centroid_error_px_rms");
+  std::cout << "board crossing: in view " << in_view << ", centroid error RMS " << rms << " px\n";
+  EXPECT_EQ(in_view, 1.0) << "the head followed the board, or lost the ken";
+  // 19.9 px when measured (the head holds still while the ken is hidden); without occlusion the
+  // goal is 20 px at 1 m/s.
+  EXPECT_LE(rms, 25.0);
   fs::remove_all(dir);
   fs::remove(json_file);
   fs::remove(dir.string() + ".log");

@@ -6,24 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include "depth_image.hpp"
+
 namespace avs::tracking {
 namespace {
 
 constexpr float nan_f = std::numeric_limits<float>::quiet_NaN();
 
-struct Image {
-  int width = 64;
-  int height = 48;
-  std::vector<float> depth = std::vector<float>(64 * 48, 3.0f);  // background beyond phi_h
-  geometry::DepthView view() const { return {depth.data(), width, height, 0}; }
-  void fill_rect(int u0, int v0, int w, int h, float d) {
-    for (int v = v0; v < v0 + h; ++v)
-      for (int u = u0; u < u0 + w; ++u) depth[v * width + u] = d;
-  }
-};
-
-const geometry::CameraModel camera{
-    .width = 64, .height = 48, .fx_px = 100.0, .fy_px = 100.0, .cx_px = 31.5, .cy_px = 23.5};
+using test::Image;
+const geometry::CameraModel& camera = test::kCamera;
 
 TEST(Moments, RectangleGivesAreaCentroidAndMeanDepth) {
   Image img;

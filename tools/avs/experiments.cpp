@@ -4,8 +4,10 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include "avs/report/paper.hpp"
+#include "avs/report/profiles.hpp"
 #include "avs/report/report.hpp"
 #include "avs/report/seeds.hpp"
 #include "avs/report/table.hpp"
@@ -45,6 +47,15 @@ std::vector<Experiment> experiments() {
     e.what = "the same swing with the head held still";
     e.run.scenario = "no_tracking";
     e.run.tracking = false;
+    list.push_back(e);
+  }
+  {
+    // Issue 19: what passes in front of the target must not take the head (the depth gate).
+    Experiment e{"occlusion", "7.1.1",
+                 "the swing with a 0.25 x 0.4 m board crossing 0.6 m in front of the head",
+                 make_run("tracking", "swing_occluded", "ken", "none", 4.0)};
+    e.run.extra_args["depth_gate_m"] = "0.15";
+    e.run.notes = "tracking depth gate 0.15 m";
     list.push_back(e);
   }
   list.push_back({"ken", "7.2.1", "ken on the manipulator trajectory, tracking and matching",
@@ -105,134 +116,194 @@ std::filesystem::path default_out_dir() {
 
 namespace {
 
+/// What the command line chose, for every scenario.
+struct ExperimentOptions {
+  std::vector<std::string> names;
+  bool json = false;
+  std::string out;
+  double time_scale = 1.0;
+  std::string calibration;
+  std::string true_calibration;
+  std::string profile = "realistic";
+  int seeds = 1;
+};
+
+/// One scenario under one sensor profile, over the chosen seeds.
+struct ScenarioResult {
+  report::SeedSpread spread;        // spread.median is the scenario's figures
+  std::filesystem::path index_dir;  // the first seed's run folder
+};
+
+std::optional<ScenarioResult> run_scenario(Experiment e, const std::string& profile,
+                                           const std::filesystem::path& dir,
+                                           const ExperimentOptions& o, int& status) {
+  e.run.dir = dir;
+  e.run.duration_s *= o.time_scale;
+  e.run.extra_args["sensor_profile"] = profile;
+  e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("sensor profile ") + profile;
+  if (!o.calibration.empty()) {
+    e.run.extra_args["calibration"] = std::filesystem::absolute(o.calibration).string();
+    e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("calibration ") +
+                   std::filesystem::path(o.calibration).filename().string();
+  }
+  if (!o.true_calibration.empty()) {
+    e.run.extra_args["true_calibration"] = std::filesystem::absolute(o.true_calibration).string();
+    e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("true calibration ") +
+                   std::filesystem::path(o.true_calibration).filename().string();
+  }
+  std::cerr << "== " << e.name << " (Sec. " << e.section << ", " << profile << "): " << e.what
+            << "\n";
+  // One run per seed; with one seed the run folder is `dir` itself.
+  std::vector<report::Summary> per_seed;
+  std::filesystem::path index_dir = e.run.dir;
+  for (int seed = 1; seed <= o.seeds && !interrupted_by_signal(); ++seed) {
+    ClosedLoopRun run = e.run;
+    if (o.seeds > 1) {
+      run.dir = e.run.dir / ("seed-" + std::to_string(seed));
+      run.extra_args["seed"] = std::to_string(seed);
+      run.notes += (run.notes.empty() ? "" : "; ") + std::string("seed ") + std::to_string(seed);
+      std::cerr << "== " << e.name << ": seed " << seed << " of " << o.seeds << "\n";
+    }
+    const ClosedLoopOutcome outcome = run_closed_loop(run, std::cerr);
+    if (outcome.status != 0) status = outcome.status;
+    try {
+      const report::Report r = report::make_report(run.dir);
+      for (const auto& failed : r.plots.failed) {
+        std::cerr << "FAILED figure " << failed.png << ": " << failed.reason << "\n";
+        status = 1;
+      }
+      per_seed.push_back(r.summary);
+      if (seed == 1) index_dir = run.dir;
+    } catch (const std::exception& ex) {
+      std::cerr << "avs experiments: " << e.name << ": no report: " << ex.what() << "\n";
+      status = 1;
+    }
+  }
+  if (per_seed.empty()) return std::nullopt;
+  return ScenarioResult{report::across_seeds(per_seed), index_dir};
+}
+
 void add_experiments_command(Command& app) {
   auto* cmd = app.add_subcommand(
       "experiments",
       "Run the paper's Sec. 7 experiments on the simulated closed loop: tracking, no_tracking, "
-      "ken, cube, cylinder, correction, init (all when none is named)");
-  static std::vector<std::string> names;
-  static bool json = false;
-  static std::string out;
-  static double time_scale = 1.0;
-  static std::string calibration;
-  static std::string true_calibration;
-  static std::string profile = "ideal";
-  static int seeds = 1;
-  cmd->add_option("NAME", names, "experiments to run (default: all)");
-  cmd->add_option("--profile", profile,
-                  "simulated optics and sensor (docs/sim.md, sensor profiles): ideal (the "
-                  "renderer of the published figures) or realistic (defocus, shot and read "
-                  "noise, gloss, texture, flicker, motion blur)")
-      ->check_member({"ideal", "realistic"})
+      "occlusion, ken, cube, cylinder, correction, init (all when none is named)");
+  static ExperimentOptions o;
+  cmd->add_option("NAME", o.names, "experiments to run (default: all)");
+  cmd->add_option("--profile", o.profile,
+                  "simulated optics and sensor (docs/sim.md, sensor profiles): realistic "
+                  "(defocus, shot and read noise, gloss, texture, flicker, motion blur), ideal "
+                  "(the renderer of the earlier published figures), or both (each scenario "
+                  "under each, folders <out>/<profile>/<name>, the figures side by side)")
+      ->check_member({"realistic", "ideal", "both"})
       ->capture_default_str();
-  cmd->add_option("--calibration", calibration,
+  cmd->add_option("--calibration", o.calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
                   "decoder only; tracking, matching and the recorder take the camera model "
                   "from /depth/camera_info (default: the paper's sensor)")
       ->check_existing_file();
-  cmd->add_option("--true-calibration", true_calibration,
+  cmd->add_option("--true-calibration", o.true_calibration,
                   "the simulated sensor's own calibration when it differs from --calibration: "
                   "the decoder gets --calibration (e.g. one recovered by avs calib solve), the "
                   "simulator this truth")
       ->check_existing_file();
-  cmd->add_option("--seeds", seeds,
+  cmd->add_option("--seeds", o.seeds,
                   "run each scenario with sensor noise seeds 1..N (folders <out>/<name>/seed-<k>) "
                   "and report the median of each figure, with the smallest and largest")
       ->check_range(1, 20)
       ->capture_default_str();
-  cmd->add_flag("--json", json, "print one JSON object keyed by scenario name on stdout");
-  cmd->add_option("--out", out, "folder for the run folders (default avs-runs/experiments-<date>)");
-  cmd->add_option("--time-scale", time_scale,
+  cmd->add_flag("--json", o.json,
+                "print one JSON object keyed by scenario name on stdout (with --profile both: "
+                "keyed by profile, then scenario)");
+  cmd->add_option("--out", o.out,
+                  "folder for the run folders (default avs-runs/experiments-<date>)");
+  cmd->add_option("--time-scale", o.time_scale,
                   "multiply every scenario's simulated duration (short smoke runs: 0.2)")
       ->check_range(0.01, 10.0)
       ->capture_default_str();
   cmd->callback([] {
     std::vector<Experiment> chosen;
     try {
-      chosen = select(names);
+      chosen = select(o.names);
     } catch (const std::exception& e) {
       std::cerr << "avs experiments: " << e.what() << "\n";
       exit_status() = 2;
       return;
     }
+    const std::vector<std::string> profiles = o.profile == "both"
+                                                  ? std::vector<std::string>{"realistic", "ideal"}
+                                                  : std::vector<std::string>{o.profile};
+    const bool side_by_side = profiles.size() > 1;
+    std::ostream& tables = o.json ? std::cerr : std::cout;
     // Absolute: the report runs gnuplot inside each run folder.
     const std::filesystem::path root =
-        std::filesystem::absolute(out.empty() ? default_out_dir() : std::filesystem::path(out));
-    std::vector<std::pair<std::string, report::Summary>> summaries;
+        std::filesystem::absolute(o.out.empty() ? default_out_dir() : std::filesystem::path(o.out));
+    // Per profile, in `profiles` order: each scenario's figures (median over the seeds).
+    std::vector<std::vector<std::pair<std::string, report::Summary>>> summaries(profiles.size());
     std::string markdown;
     int status = 0;
-    for (auto& e : chosen) {
+    const std::string seeds_note =
+        o.seeds > 1 ? "median of " + std::to_string(o.seeds) + " seeds; " : "";
+    for (const auto& e : chosen) {
       if (interrupted_by_signal()) break;
-      e.run.dir = root / e.name;
-      e.run.duration_s *= time_scale;
-      e.run.extra_args["sensor_profile"] = profile;
-      if (profile != "ideal") {
-        e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("sensor profile ") + profile;
-      }
-      if (!calibration.empty()) {
-        e.run.extra_args["calibration"] = std::filesystem::absolute(calibration).string();
-        e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("calibration ") +
-                       std::filesystem::path(calibration).filename().string();
-      }
-      if (!true_calibration.empty()) {
-        e.run.extra_args["true_calibration"] = std::filesystem::absolute(true_calibration).string();
-        e.run.notes += (e.run.notes.empty() ? "" : "; ") + std::string("true calibration ") +
-                       std::filesystem::path(true_calibration).filename().string();
-      }
-      std::cerr << "== " << e.name << " (Sec. " << e.section << "): " << e.what << "\n";
-      // One run per seed; with one seed the run folder is <out>/<name> as before.
-      std::vector<report::Summary> per_seed;
-      std::filesystem::path index_dir = e.run.dir;
-      for (int seed = 1; seed <= seeds && !interrupted_by_signal(); ++seed) {
-        ClosedLoopRun run = e.run;
-        if (seeds > 1) {
-          run.dir = e.run.dir / ("seed-" + std::to_string(seed));
-          run.extra_args["seed"] = std::to_string(seed);
-          run.notes +=
-              (run.notes.empty() ? "" : "; ") + std::string("seed ") + std::to_string(seed);
-          std::cerr << "== " << e.name << ": seed " << seed << " of " << seeds << "\n";
+      std::vector<report::ProfileSummary> per_profile;
+      std::string reports;     // the run folders, for the side-by-side heading
+      std::string profile_md;  // per profile: clocks and spread, under the side-by-side table
+      for (std::size_t k = 0; k < profiles.size() && !interrupted_by_signal(); ++k) {
+        const std::string& profile = profiles[k];
+        const auto result = run_scenario(
+            e, profile, side_by_side ? root / profile / e.name : root / e.name, o, status);
+        if (!result) continue;
+        const report::Summary& summary = result->spread.median;
+        const std::string index = (result->index_dir / "index.html").string();
+        tables << "\n"
+               << e.name << " (Sec. " << e.section << ", " << profile << " sensor, " << seeds_note
+               << index << ")\n"
+               << report::format_comparison_table(e.run.scenario, summary)
+               << report::format_run_clocks(summary) << "\n";
+        if (o.seeds > 1) tables << report::format_seed_spread(result->spread);
+        tables << "\n";
+        const std::string spread_md =
+            o.seeds > 1 ? report::format_seed_spread(result->spread, true) + "\n" : "";
+        if (side_by_side) {
+          reports += (reports.empty() ? "" : ", ") + profile + ": `" + index + "`";
+          profile_md +=
+              "**" + profile + "**: " + report::format_run_clocks(summary) + "\n\n" + spread_md;
+        } else {
+          markdown += "## " + e.name + " (Sec. " + e.section + ")\n\n" + e.what + ". " +
+                      (o.seeds > 1 ? "Median of " + std::to_string(o.seeds) + " seeds. " : "") +
+                      "Report: `" + index + "`.\n\n" +
+                      report::format_comparison_markdown(e.run.scenario, summary) + "\n" +
+                      spread_md + report::format_run_clocks(summary) + "\n\n";
         }
-        const ClosedLoopOutcome outcome = run_closed_loop(run, std::cerr);
-        if (outcome.status != 0) status = outcome.status;
-        try {
-          const report::Report r = report::make_report(run.dir);
-          for (const auto& failed : r.plots.failed) {
-            std::cerr << "FAILED figure " << failed.png << ": " << failed.reason << "\n";
-            status = 1;
-          }
-          per_seed.push_back(r.summary);
-          if (seed == 1) index_dir = run.dir;
-        } catch (const std::exception& ex) {
-          std::cerr << "avs experiments: " << e.name << ": no report: " << ex.what() << "\n";
-          status = 1;
-        }
+        per_profile.emplace_back(profile, summary);
+        summaries[k].emplace_back(e.name, summary);
       }
-      if (per_seed.empty()) continue;
-      {
-        const report::SeedSpread spread = report::across_seeds(per_seed);
-        const report::Summary& summary = spread.median;
-        const std::string seeds_note =
-            seeds > 1 ? "median of " + std::to_string(per_seed.size()) + " seeds; " : "";
-        const std::string table = report::format_comparison_table(e.run.scenario, summary);
-        (json ? std::cerr : std::cout) << "\n"
-                                       << e.name << " (Sec. " << e.section << ", " << seeds_note
-                                       << index_dir.string() << "/index.html)\n"
-                                       << table << report::format_run_clocks(summary) << "\n";
-        if (seeds > 1) (json ? std::cerr : std::cout) << report::format_seed_spread(spread);
-        (json ? std::cerr : std::cout) << "\n";
+      if (side_by_side && !per_profile.empty()) {
+        tables << e.name << " (Sec. " << e.section << "), " << seeds_note
+               << "the sensor profiles side by side\n"
+               << report::format_profiles_side_by_side(e.run.scenario, per_profile) << "\n";
         markdown += "## " + e.name + " (Sec. " + e.section + ")\n\n" + e.what + ". " +
-                    (seeds > 1 ? "Median of " + std::to_string(per_seed.size()) + " seeds. " : "") +
-                    "Report: `" + (index_dir / "index.html").string() + "`.\n\n" +
-                    report::format_comparison_markdown(e.run.scenario, summary) + "\n" +
-                    (seeds > 1 ? report::format_seed_spread(spread, true) + "\n" : "") +
-                    report::format_run_clocks(summary) + "\n\n";
-        summaries.emplace_back(e.name, summary);
+                    (o.seeds > 1 ? "Median of " + std::to_string(o.seeds) + " seeds. " : "") +
+                    "Reports: " + reports + ".\n\n" +
+                    report::format_profiles_side_by_side(e.run.scenario, per_profile, true) + "\n" +
+                    profile_md;
       }
     }
-    const std::string json_text = report::experiments_json(summaries);
+    std::string json_text;
+    if (side_by_side) {
+      json_text = "{";
+      for (std::size_t k = 0; k < profiles.size(); ++k) {
+        json_text +=
+            (k > 0 ? ", \"" : "\"") + profiles[k] + "\": " + report::experiments_json(summaries[k]);
+      }
+      json_text += "}";
+    } else {
+      json_text = report::experiments_json(summaries.front());
+    }
     std::ofstream(root / "experiments.json") << json_text << "\n";
     std::ofstream(root / "experiments.md") << markdown;
-    if (json) std::cout << json_text << "\n";
+    if (o.json) std::cout << json_text << "\n";
     std::cerr << "experiments: " << root.string() << " (experiments.json, experiments.md)\n";
     if (interrupted_by_signal()) {
       std::cerr << "avs experiments: interrupted: the results above are partial\n";

@@ -1,5 +1,7 @@
 #include "avs/tracking/moments.hpp"
 
+#include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -17,20 +19,34 @@ TargetObservation measure_target(const geometry::DepthView& depth,
   const float hi = static_cast<float>(config.depth_max_m);
   // Sums per row in integers/floats, then in double: exact for 512x512 images.
   double m00 = 0, m10 = 0, m01 = 0, depth_sum = 0;
-  for (int v = 0; v < depth.height_px; ++v) {
+  const PixelBox& region = config.region;
+  const int u_begin = std::max(0, region.u_min);
+  const int u_end = std::min(depth.width_px - 1, region.u_max);
+  const int v_begin = std::max(0, region.v_min);
+  const int v_end = std::min(depth.height_px - 1, region.v_max);
+  PixelBox bounds{std::numeric_limits<int>::max(), -1, std::numeric_limits<int>::max(), -1};
+  for (int v = v_begin; v <= v_end; ++v) {
     const float* row = depth.depth_m + static_cast<std::size_t>(v) * stride;
     long count = 0;
     long u_sum = 0;
     double row_depth = 0;
-    for (int u = 0; u < depth.width_px; ++u) {
+    int first = -1;
+    int last = -1;
+    for (int u = u_begin; u <= u_end; ++u) {
       const float h = row[u];
       if (lo < h && h < hi) {  // Eq. 8 (NaN compares false)
         ++count;
         u_sum += u;
         row_depth += h;
+        if (first < 0) first = u;
+        last = u;
       }
     }
     if (count == 0) continue;
+    bounds.u_min = std::min(bounds.u_min, first);
+    bounds.u_max = std::max(bounds.u_max, last);
+    bounds.v_min = std::min(bounds.v_min, v);
+    bounds.v_max = v;
     m00 += static_cast<double>(count);
     m10 += static_cast<double>(u_sum) - camera.cx_px * static_cast<double>(count);
     m01 += (v - camera.cy_px) * static_cast<double>(count);
@@ -50,6 +66,7 @@ TargetObservation measure_target(const geometry::DepthView& depth,
       obs.m_g_px = ideal - Eigen::Vector2d(camera.cx_px, camera.cy_px);
     }
     obs.mean_depth_m = depth_sum / m00;
+    obs.bounds = bounds;
   }
   obs.present = m00 > 0 && m00 >= config.min_area_px;
   return obs;

@@ -18,6 +18,7 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
 #include "avs/runtime/rejections.hpp"
+#include "avs/tracking/depth_gate.hpp"
 #include "avs/tracking/tracker.hpp"
 
 namespace avs::tracking {
@@ -64,6 +65,7 @@ class TrackingComponent final : public runtime::Component {
   struct CoreConfig {
     TrackerConfig tracker;
     MomentsConfig moments;
+    DepthGateConfig gate;
   };
 
   /// Parameters bound to the core configs (Eqs. 8, 15, 16 and the tracking states).
@@ -76,6 +78,27 @@ class TrackingComponent final : public runtime::Component {
             .live()
             .real("min_area_px", AVS_FIELD(moments.min_area_px), 1.0, 1e7, "px",
                   "m00 below this: no target")
+            .live()
+            .real("depth_gate_m", AVS_FIELD(gate.half_width_m), 0.0, 10.0, "m",
+                  "once a target is seen, Eq. 8's window narrows to its mean depth +- this, so "
+                  "what passes in front of it is left out (0: off, the paper's fixed window)")
+            .live()
+            .integer("depth_gate_release_frames", AVS_FIELD(gate.release_frames), 1, 10000000, "",
+                     "depth images without a target before the gate opens to Eq. 8's window")
+            .live()
+            .real("depth_gate_max_step_m", AVS_FIELD(gate.max_step_m), 1e-6, 10.0, "m",
+                  "with the gate: its centre follows the target by at most this per image")
+            .live()
+            .real("depth_gate_region_scale", AVS_FIELD(gate.region_scale), 0.0, 1000.0, "",
+                  "with the gate: only pixels within this x sqrt(m00) (plus "
+                  "depth_gate_region_margin_px) of the last centroid can be target")
+            .live()
+            .integer("depth_gate_region_margin_px", AVS_FIELD(gate.region_margin_px), 0, 100000,
+                     "px", "with the gate: added to the region's half-size")
+            .live()
+            .real("depth_gate_min_area_share", AVS_FIELD(gate.min_area_share), 0.0, 1.0, "",
+                  "with the gate: a mask below this share of the target's running area is no "
+                  "target (it is hidden)")
             .live()
             .choice("jacobian", AVS_FIELD(tracker.law.jacobian),
                     std::vector<std::pair<std::string, JacobianForm>>{
@@ -127,6 +150,7 @@ class TrackingComponent final : public runtime::Component {
         timing_(ctx.publisher<msgs::avs_msgs::StageTiming>("timing")),
         core_(params().make(ctx.parameters())),
         tracker_(core_.tracker),
+        gate_(core_.gate),
         enabled_(ctx.param<bool>("enabled")),
         report_dir_(ctx.param<std::string>("report_dir")),
         rejected_(ctx.log(), "input") {
@@ -160,6 +184,7 @@ class TrackingComponent final : public runtime::Component {
       throw std::invalid_argument("depth_min_m must be below depth_max_m");
     }
     tracker_.retune(core.tracker);
+    gate_.retune(core.gate);
     moments_ = core.moments;
     enabled_ = values.get<bool>("enabled");
   }
@@ -212,7 +237,9 @@ class TrackingComponent final : public runtime::Component {
     ++images_;
     const auto started = std::chrono::steady_clock::now();
     const geometry::DepthView& view = *layout;
-    TargetObservation obs = measure_target(view, *camera_.model(), moments_);  // Eqs. 7-9
+    // Eqs. 7-9 in Eq. 8's window, narrowed to the target's depth once one is seen (DepthGate).
+    TargetObservation obs = measure_target(view, *camera_.model(), gate_.window(moments_));
+    obs.present = gate_.observe(obs);  // a remnant of a hidden target is no target
     if (obs.present) ++frames_with_target_;
     publish_target(image, obs);
 
@@ -285,6 +312,7 @@ class TrackingComponent final : public runtime::Component {
   runtime::Publisher<msgs::avs_msgs::StageTiming> timing_;
   CoreConfig core_;
   Tracker tracker_;
+  DepthGate gate_;
   bool enabled_;
   std::string report_dir_;
   runtime::SampleRejections rejected_;

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -13,10 +14,21 @@
 
 namespace avs::tracking {
 
+/// Pixels u_min <= u <= u_max, v_min <= v <= v_max (the whole image by default).
+struct PixelBox {
+  int u_min = 0;
+  int u_max = std::numeric_limits<int>::max();
+  int v_min = 0;
+  int v_max = std::numeric_limits<int>::max();
+};
+
 struct MomentsConfig {
   double depth_min_m = 0.3;  ///< phi_l (Eq. 8)
   double depth_max_m = 1.5;  ///< phi_h (Eq. 8)
   double min_area_px = 50;   ///< m00 below this: no target
+  /// Only these pixels can be target (our addition: the DepthGate's region around the last
+  /// target; the paper's mask is the whole image).
+  PixelBox region;
 };
 
 struct TargetObservation {
@@ -30,6 +42,7 @@ struct TargetObservation {
   double centroid_u_px = 0;  ///< the mask's centroid in image pixels (u right, v down)
   double centroid_v_px = 0;
   double mean_depth_m = 0;  ///< X_c: mean depth over the mask
+  PixelBox bounds;          ///< the mask's bounding box (when m00 > 0)
 };
 
 /// Eqs. 7-9 over the whole image (NaN, or any value outside the window, is not target). Pixel
