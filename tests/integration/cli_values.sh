@@ -10,10 +10,13 @@ refused() {  # refused "what the error must say" ARGS...: exit status 2..109 and
   local err status
   err=$(timeout 10 "$avs" "$@" 2>&1 >/dev/null); status=$?
   ((status != 0 && status != 124)) || fail "avs $* was accepted (status $status)"
+  ((status < 128)) || fail "avs $* died of signal $((status - 128)) instead of refusing"
   grep -qF -- "$want" <<<"$err" || fail "avs $*: expected '$want' in: $err"
   echo "ok: avs $* -> $(head -n 1 <<<"$err")"
 }
 refused "unknown command 'nosuchcmd'; commands: demo" nosuchcmd
+# A bad AVS_DOMAIN_ID is read while the commands are built: it used to abort (status 134).
+AVS_DOMAIN_ID=999 refused "avs: AVS_DOMAIN_ID must be a domain id in [0, 232], got '999'" topic list
 refused "--wait: a finite number is needed, got nan" topic echo /chatter --wait nan
 refused "--wait: Value -1 not in range" topic hz /chatter --wait -1
 refused "--rate: a finite number is needed, got inf" bag play none.mcap --rate inf
