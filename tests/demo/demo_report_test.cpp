@@ -128,7 +128,10 @@ TEST(Demo, RealtimePacesSimulatedTimeByTheWallClockAndSaysSo) {
   ASSERT_TRUE(std::isfinite(s.real_time_factor)) << output;
   // First to last row: within a frame period of the pacing (10 %), never lockstep's pace.
   EXPECT_LE(s.real_time_factor, 0.05 * 1.1) << output;
-  EXPECT_GT(s.frames, 10) << output;
+  // Enough rows for the factor to mean something. Not more: under ASan on a loaded machine the
+  // start-up takes most of the run's wall-clock budget (8 depth maps once in CI, 2026-12-06), and
+  // a test must not depend on the machine's speed.
+  EXPECT_GE(s.frames, 3) << output;
   fs::remove_all(dir);
 
   // A factor out of range is refused with the reason.
