@@ -175,7 +175,8 @@ Run run(const Setup& setup) {
     config.scene.outlier_neighbours = 8;
     config.tracker.icp.iterations = {0, 0, 2};
   }
-  if (setup.trimmed) {
+  // AVS_MATCHING_TRIMMED=1: every run with the trimmed settings (docs/matching.md, clutter).
+  if (setup.trimmed || std::getenv("AVS_MATCHING_TRIMMED") != nullptr) {
     config.tracker.icp.trim_factor = 2.5F;
     config.tracker.initial.trim_factor = 2.5F;
     config.tracker.initial.score_trim_fraction = 0.6F;

@@ -8,15 +8,6 @@
 #include "avs/report/table.hpp"
 
 namespace avs::report {
-namespace {
-
-std::string markdown_cell(const std::string& text) {
-  std::string out;
-  for (const char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
-  return out;
-}
-
-}  // namespace
 
 std::string format_profiles_side_by_side(const std::string& scenario,
                                          const std::vector<ProfileSummary>& profiles,

@@ -75,6 +75,12 @@ std::string format_figure(double value) {
   return buffer;
 }
 
+std::string markdown_cell(const std::string& text) {
+  std::string out;
+  for (const char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+  return out;
+}
+
 const std::vector<std::string>& comparison_headers() {
   static const std::vector<std::string> headers{"figure", "statistic", "clock",   "paper",
                                                 "ours",   "unit",      "verdict", "section"};
@@ -105,11 +111,6 @@ std::string format_comparison_table(const std::string& scenario, const Summary& 
 }
 
 std::string format_comparison_markdown(const std::string& scenario, const Summary& summary) {
-  const auto cell = [](const std::string& text) {
-    std::string out;
-    for (const char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
-    return out;
-  };
   std::string out = "|";
   std::string rule = "|";
   for (const std::string& header : comparison_headers()) {
@@ -119,7 +120,7 @@ std::string format_comparison_markdown(const std::string& scenario, const Summar
   out += "\n" + rule + "\n";
   for (const ComparisonRow& row : comparison_rows(scenario, summary)) {
     out += "|";
-    for (const std::string& text : comparison_cells(row)) out += " " + cell(text) + " |";
+    for (const std::string& text : comparison_cells(row)) out += " " + markdown_cell(text) + " |";
     out += "\n";
   }
   return out;

@@ -24,6 +24,9 @@ class TextTable {
 /// A figure for a table: "-" for NaN, integers without decimals, else 4 significant digits.
 [[nodiscard]] std::string format_figure(double value);
 
+/// Text for a Markdown table cell: '|' escaped.
+[[nodiscard]] std::string markdown_cell(const std::string& text);
+
 /// The columns of the results table, in order.
 [[nodiscard]] const std::vector<std::string>& comparison_headers();
 
