@@ -36,17 +36,35 @@ for p in sys.argv[2].split(","):
             sys.exit(f"missing key {key}")
     if d[f"placement.{p}.depth_maps"] < 1 or d[f"placement.{p}.poses"] < 1:
         sys.exit(f"{p}: no depth maps or no poses came out")
-for k in ("load_average_1min_before", "seconds_per_placement"):
+for k in ("load_average_1min_before", "seconds_per_placement", "source_closed_loop"):
     if k not in d:
         sys.exit(f"missing key {k}")
+if d["source_closed_loop"] != 1:
+    sys.exit("the default source is not the closed loop's recording")
+for p in sys.argv[2].split(","):
+    if f"placement.{p}.source_late_frames" not in d:
+        sys.exit(f"missing key placement.{p}.source_late_frames")
 PY
 for f in latency_histogram.png latency_over_time.png latency_intra_process.csv; do
   [ -s "$W/out/$f" ] || fail "$f not written"
 done
 
-# The table form: the paper beside ours, and the load average.
+# The default source is recorded from the lockstep closed loop first (the head follows the
+# ken): the recording is in the output folder, and the replay read whole cycles of it.
+[ -s "$W/out/closed_loop.mcap" ] || fail "no closed-loop recording in the output folder"
+grep -q "read 90 frames (5 cycles of 18) of .*closed_loop.mcap" "$W/bench.log" ||
+  fail "the source did not read 5 whole cycles of the recording"
+
+# The table form, replaying that recording (--bag): the paper beside ours, and the load average.
 "$AVS" bench pipeline --seconds=1 --recorded-frames=90 --placements=intra_process \
-  --dir="$W/out2" >"$W/table.txt" 2>"$W/bench.log" || fail "avs bench pipeline (table) failed"
+  --bag="$W/out/closed_loop.mcap" --dir="$W/out2" >"$W/table.txt" 2>"$W/bench.log" ||
+  fail "avs bench pipeline (table) failed"
+[ -e "$W/out2/closed_loop.mcap" ] && fail "--bag recorded the closed loop again"
+grep -q "recorded in the closed loop: $W/out/closed_loop.mcap" "$W/table.txt" ||
+  fail "the table does not name the recording replayed"
+"$AVS" bench pipeline --bag="$W/nonexistent.mcap" >"$W/bad.txt" 2>&1 &&
+  fail "a missing --bag file was accepted"
+grep -q "no such file" "$W/bad.txt" || fail "a missing --bag file is not named: $(cat "$W/bad.txt")"
 grep -q "paper" "$W/table.txt" || fail "no paper figures beside ours"
 grep -q "load average" "$W/table.txt" || fail "no load average printed"
 echo "PASS: avs bench pipeline ($placements)"

@@ -29,6 +29,24 @@ std::string bool_word(bool b) {
   return b ? "true" : "false";
 }
 
+/// A bag_recorder instance (every parameter its default but these) for the loop's container.
+graph::ComponentInstance bag_recorder(const ClosedLoopRun& run) {
+  const auto* registered = runtime::ComponentRegistry::instance().find("bag_recorder");
+  if (registered == nullptr) throw runtime::Error("this avs has no bag_recorder component");
+  graph::ComponentInstance instance;
+  instance.type = "bag_recorder";
+  instance.name = "closed_loop_bag";
+  for (const auto& p : registered->spec.parameters) {
+    instance.parameters.set(p.name, p.default_value);
+  }
+  instance.parameters.set("file", std::filesystem::absolute(run.bag).string());
+  instance.parameters.set("topics", run.bag_topics);
+  instance.parameters.set("if_exists", std::string("overwrite"));
+  instance.parameters.set("compression", std::string("lz4"));  // camera frames: speed over size
+  instance.where.file = "(avs: the closed loop's bag, " + run.bag.string() + ")";
+  return instance;
+}
+
 std::string progress_line(const runtime::Container& container,
                           const run_recorder::RecorderProgress* progress, double duration_s,
                           double wall_s) {
@@ -115,6 +133,7 @@ ClosedLoopOutcome run_closed_loop(const ClosedLoopRun& run, std::ostream& progre
   auto graph = load_or_report(closed_loop_graph().string(), words);
   if (!graph) return outcome;
   graph->domain_id = choose_closed_loop_domain(run, progress);
+  if (!run.bag.empty()) graph->containers.front().components.push_back(bag_recorder(run));
   if (run.realtime_factor) {
     // Paced by the wall clock (docs/graphs.md, clock: mode realtime): the camera does not wait
     // for decode any more, stages that fall behind skip to the newest input and count it.

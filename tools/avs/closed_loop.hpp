@@ -29,6 +29,10 @@ struct ClosedLoopRun {
   std::string notes;
   std::map<std::string, std::string> extra_args;  ///< more graph arguments NAME -> VALUE
   std::filesystem::path dir;                      ///< run folder
+  /// Set: a bag_recorder in the loop's container records `bag_topics` (comma-separated ROS
+  /// names) into this MCAP file (overwritten), losing nothing: lockstep waits for it.
+  std::filesystem::path bag;
+  std::string bag_topics = "/camera/pattern";
 };
 
 struct ClosedLoopOutcome {

@@ -115,18 +115,27 @@ void add_demo_command(Command& app) {
   add_live_view_options(cmd, view, "the run");
   static std::string realtime;
   static Option* realtime_option = nullptr;
-  realtime_option = cmd->add_option("--realtime", realtime,
-                  "[FACTOR] pace simulated time by the wall clock at FACTOR x real time "
-                  "(0 < FACTOR <= 1) instead of lockstep; `auto` or no value: 0.8 x the factor "
-                  "this machine reaches in a 0.2 s lockstep run of the same loop")
-      ->optional_value();
+  realtime_option =
+      cmd->add_option("--realtime", realtime,
+                      "[FACTOR] pace simulated time by the wall clock at FACTOR x real time "
+                      "(0 < FACTOR <= 1) instead of lockstep; `auto` or no value: 0.8 x the factor "
+                      "this machine reaches in a 0.2 s lockstep run of the same loop")
+          ->optional_value();
   static std::string calibration;
   cmd->add_option("--calibration", calibration,
                   "sensor calibration YAML (docs/decode.md) for the simulated sensor and the "
                   "decoder; the other components take it from /depth/camera_info")
       ->check_existing_file();
+  static std::string bag;
+  cmd->add_option("--bag", bag,
+                  "also record --bag-topics into this MCAP file (overwritten; lockstep waits "
+                  "for the recorder, so nothing is lost): e.g. the camera stream that avs bench "
+                  "pipeline --bag replays");
+  cmd->add_option("--bag-topics", run.bag_topics, "comma-separated topics --bag records")
+      ->capture_default_str();
   cmd->callback([] {
     run.scenario = "demo";
+    if (!bag.empty()) run.bag = std::filesystem::absolute(bag);
     run.tracking = !no_tracking;
     if (!calibration.empty()) {
       run.extra_args["calibration"] = std::filesystem::absolute(calibration).string();
@@ -145,10 +154,9 @@ void add_demo_command(Command& app) {
                   " x real time (avs demo --realtime)";
     }
     std::cerr << "avs demo: simulated closed loop, " << run.duration_s << " s of sim time "
-              << (run.realtime_factor
-                      ? "paced by the wall clock at " + format_factor(*run.realtime_factor) +
-                            " x real time"
-                      : std::string("in lockstep"))
+              << (run.realtime_factor ? "paced by the wall clock at " +
+                                            format_factor(*run.realtime_factor) + " x real time"
+                                      : std::string("in lockstep"))
               << " (graph " << closed_loop_graph().string() << ", scene " << run.scene
               << "); Ctrl-C ends it early with a partial report\n";
     const std::unique_ptr<view::View> live =

@@ -20,6 +20,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -152,9 +153,17 @@ AVS_REGISTER_COMPONENT(PipelineProbe);
 
 // ---- options ----------------------------------------------------------------------------------
 
+/// Where the replayed /camera/pattern stream comes from.
+enum class Source {
+  closed_loop,  ///< a bag recorded from the lockstep closed loop (the head follows the ken)
+  still_head,   ///< rendered by pattern_replay with the head still (the ken leaves the view)
+};
+
 struct Options {
   double seconds = 30;
   int recorded_frames = 1008;
+  Source source = Source::closed_loop;
+  fs::path bag;  ///< a recording to replay; empty with closed_loop: record <dir>/closed_loop.mcap
   std::vector<std::string> placements{"intra_process", "udp", "shm"};
   fs::path dir = "avs_bench_pipeline";
 };
@@ -165,17 +174,41 @@ Options parse_options(const std::vector<std::string>& raw) {
   if (given.flag("--help") || given.flag("-h")) {
     std::printf(
         "avs bench pipeline [--json] [--seconds=S] [--placements=intra_process,udp,shm]\n"
-        "                   [--recorded-frames=N] [--dir=DIR]\n"
-        "Replays N rendered /camera/pattern frames (the ken on the manipulator trajectory,\n"
-        "forwards and backwards by cycle) at 1000 fps of wall-clock time for S seconds per\n"
-        "placement into decode -> tracking -> matching; writes latency figures and CSV to DIR\n"
-        "(default ./avs_bench_pipeline).\n");
+        "                   [--recorded-frames=N] [--dir=DIR] [--source=closed_loop|still_head]\n"
+        "                   [--bag=FILE]\n"
+        "Replays N recorded /camera/pattern frames (the ken on the manipulator trajectory from\n"
+        "t = 0.5 s, forwards and backwards by cycle) at 1000 fps of wall-clock time for S\n"
+        "seconds per placement into decode -> tracking -> matching; writes latency figures and\n"
+        "CSV to DIR (default ./avs_bench_pipeline).\n"
+        "  --source=closed_loop  (default) the stream a rig's camera sees while the head follows\n"
+        "                        the ken: recorded first from the lockstep closed loop into\n"
+        "                        DIR/closed_loop.mcap (a few seconds per 100 frames), or --bag\n"
+        "  --bag=FILE            replay this MCAP recording of /camera/pattern (whole cycles from\n"
+        "                        stamp 0.5 s; record one with avs launch closed_loop.yaml and\n"
+        "                        avs bag record /camera/pattern: lockstep waits for the recorder)\n"
+        "  --source=still_head   frames rendered with the head still: the ken leaves the view\n"
+        "                        in mid-swing (the bench before 2026-12-06)\n");
     std::exit(0);
   }
   o.seconds = given.number("--seconds", o.seconds, 0.1, 3600.0);
   o.recorded_frames =
       static_cast<int>(given.integer("--recorded-frames", o.recorded_frames, 1, 100000));
   o.dir = given.text("--dir", o.dir.string());
+  if (const std::string v = given.text("--source", "closed_loop"); v == "still_head") {
+    o.source = Source::still_head;
+  } else if (v != "closed_loop") {
+    throw runtime::Error("avs bench pipeline: unknown --source '" + v +
+                         "' (closed_loop, still_head)");
+  }
+  o.bag = given.text("--bag", "");
+  if (!o.bag.empty() && o.source != Source::closed_loop) {
+    throw runtime::Error(
+        "avs bench pipeline: --bag replays a recording; --source=still_head "
+        "renders one (give one of them)");
+  }
+  if (!o.bag.empty() && !fs::is_regular_file(o.bag)) {
+    throw runtime::Error("avs bench pipeline: --bag " + o.bag.string() + ": no such file");
+  }
   if (const std::string v = given.text("--placements", ""); !v.empty()) {
     o.placements.clear();
     std::stringstream ss(v);
@@ -199,6 +232,27 @@ Options parse_options(const std::vector<std::string>& raw) {
 // ---- the graph --------------------------------------------------------------------------------
 
 constexpr double kSourceStartDelayS = 2.0;  ///< after activation: discovery, other activations
+constexpr double kRecordingStartS = 0.5;    ///< the manipulator starts to move (scene time)
+
+/// Records the closed loop's /camera/pattern (lockstep, ken on the manipulator trajectory, the
+/// head following it) into `bag`, long enough for recorded_frames frames from
+/// kRecordingStartS: `avs demo --bag` in a child process, so that this process's DDS domain
+/// keeps the configuration the placements set up.
+void record_closed_loop(const Options& o, const fs::path& bag, const std::string& xml, int domain) {
+  const double seconds = kRecordingStartS + 1e-3 * o.recorded_frames + 0.05;
+  const fs::path dir = fs::absolute(o.dir);
+  std::cerr << "avs bench pipeline: recording the closed loop's /camera/pattern (avs demo, "
+            << seconds << " s of simulated time, lockstep) into " << bag.string() << " (log "
+            << (dir / "closed_loop_run.log").string() << ")\n";
+  AvsChild demo({"demo", "--seconds", std::to_string(seconds), "--out",
+                 (dir / "closed_loop_run").string(), "--bag", bag.string()},
+                xml, domain, dir / "closed_loop_run.log", "the closed-loop recording");
+  const int status = demo.wait();
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !fs::is_regular_file(bag)) {
+    throw runtime::Error("avs bench pipeline: recording the closed loop failed (see " +
+                         (dir / "closed_loop_run.log").string() + ")");
+  }
+}
 
 /// The bench graph: containers "all" (source + pipeline, intra_process) or "source" and
 /// "pipeline" (the other placements). The pipeline's parameters are closed_loop.yaml's.
@@ -207,7 +261,9 @@ std::string graph_yaml(const Options& o, bool one_container, const fs::path& sou
   std::ostringstream source;
   source << "      - type: pattern_replay\n        name: source\n        parameters: {"
          << "scene: manipulator_ken, recorded_frames: " << o.recorded_frames
-         << ", rate_hz: 1000, wait_for_readers: " << (one_container ? 0 : 1)
+         << ", start_time_s: " << kRecordingStartS;
+  if (!o.bag.empty()) source << ", bag: '" << fs::absolute(o.bag).string() << "'";
+  source << ", rate_hz: 1000, wait_for_readers: " << (one_container ? 0 : 1)
          << ", start_delay_s: " << kSourceStartDelayS << ", duration_s: " << o.seconds
          << ", report_file: " << source_report.string() << "}\n";
   const std::string pipeline =
@@ -272,6 +328,8 @@ struct PlacementResult {
   ProbeData probe;
   double depth_rate_hz = 0, pose_rate_hz = 0;
   std::int64_t negatives = 0, missed_slots = 0, decode_dropped = 0, decode_out_of_order = 0;
+  std::int64_t late_frames = 0;  ///< handed over a period or more after their slot
+  double max_late_ms = 0;
   std::int64_t depth_missing = 0, tracking_missing = 0, matching_missing = 0;
   double cpu_percent_pipeline = 0, cpu_percent_source = -1;  ///< -1: same process
   std::string transport;
@@ -361,6 +419,8 @@ PlacementResult run_placement(const Options& o, const std::string& placement, in
   }
   r.negatives = static_cast<std::int64_t>(source.at("negatives"));
   r.missed_slots = static_cast<std::int64_t>(source.at("missed_slots"));
+  r.late_frames = static_cast<std::int64_t>(source.at("late_frames"));
+  r.max_late_ms = source.at("max_late_ms");
   const runtime::Component* decode = container.find_component("decode");
   r.decode_dropped = diagnostic(decode, "dropped_frames");
   r.decode_out_of_order = diagnostic(decode, "out_of_order_frames");
@@ -485,6 +545,8 @@ void add_rows(bench::Report& report, const PlacementResult& r) {
   report.json[key + "poses"] = static_cast<double>(r.probe.poses);
   report.json[key + "depth_maps"] = static_cast<double>(r.probe.depth);
   report.json[key + "source_missed_slots"] = static_cast<double>(r.missed_slots);
+  report.json[key + "source_late_frames"] = static_cast<double>(r.late_frames);
+  report.json[key + "source_max_late_ms"] = r.max_late_ms;
   report.json[key + "decode_dropped_frames"] = static_cast<double>(r.decode_dropped);
   report.json[key + "decode_out_of_order_frames"] = static_cast<double>(r.decode_out_of_order);
   report.json[key + "depth_missing"] = static_cast<double>(r.depth_missing);
@@ -497,13 +559,15 @@ void add_rows(bench::Report& report, const PlacementResult& r) {
        << r.decode_dropped << ", out of order " << r.decode_out_of_order
        << ", negatives without depth " << r.depth_missing << ", depth without target "
        << r.tracking_missing << ", depth without match result " << r.matching_missing
-       << "; source slots missed " << r.missed_slots << " (late ticks of the source itself); "
+       << "; source: " << r.late_frames << " frames handed over late (at most " << r.max_late_ms
+       << " ms after their slot, counted in the latency: stamps are slot times), " << r.missed_slots
+       << " slots missed (more than the camera's 32 buffers behind); "
        << "load average after it: " << r.loadavg;
   report.notes.push_back(note.str());
 }
 
 bench::Report pipeline_bench(const std::vector<std::string>& args) {
-  const Options o = parse_options(args);
+  Options o = parse_options(args);
   fs::create_directories(o.dir);
   const int domain = domain_or_environment(181);
   deploy::Deployment d;
@@ -511,12 +575,19 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
   const std::string udp_xml = deploy::cyclone_config(d, d.hosts[0], "bench");
   d.shared_memory.enabled = true;
   const std::string shm_xml = deploy::cyclone_config(d, d.hosts[0], "bench");
+  if (o.source == Source::closed_loop && o.bag.empty()) {
+    o.bag = fs::absolute(o.dir) / "closed_loop.mcap";
+    record_closed_loop(o, o.bag, udp_xml, domain);
+  }
 
   bench::Report report;
   std::ostringstream title;
   const std::string load_before = bench::load_average();
   title << "avs bench pipeline: /camera/pattern at 1000 fps of wall-clock time for " << o.seconds
-        << " s per placement -> decode -> tracking -> matching (ken, manipulator trajectory); "
+        << " s per placement -> decode -> tracking -> matching (ken, manipulator trajectory, "
+        << (o.source == Source::closed_loop ? "recorded in the closed loop: " + o.bag.string()
+                                            : std::string("rendered, head still"))
+        << "); "
         << "load average before: " << load_before << " (2-core machine shared with builds)";
   report.title = title.str();
   std::vector<PlacementResult> results;
@@ -545,9 +616,12 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
   report.notes.push_back(
       "ratio = paper / avs (for rates: above 1 means we are slower than the paper; for times "
       "and latency: above 1 means we are faster). Latency is measured at an in-process "
-      "subscriber of /object/pose beside matching; stamps are the source's clock at hand-over.");
+      "subscriber of /object/pose beside matching; stamps are the frames' slot times on the "
+      "absolute 1 ms grid (a camera's exposure stamp), so a late hand-over by the source counts in "
+      "the latency.");
   report.json["seconds_per_placement"] = o.seconds;
   report.json["recorded_frames"] = o.recorded_frames;
+  report.json["source_closed_loop"] = o.source == Source::closed_loop ? 1 : 0;
   report.json["load_average_1min_before"] = std::atof(load_before.c_str());
   report.json["load_average_1min_after"] = std::atof(bench::load_average().c_str());
   return report;
