@@ -273,7 +273,7 @@ std::string graph_yaml(const Options& o, bool one_container, const fs::path& sou
       "      - type: matching\n        name: matching\n        parameters: {model: ken, "
       "lag_compensation_s: 0.009, velocity_window_s: 0.03, icp_model: dense, "
       "icp_max_distance_m: 0.015, scene_points: 500, scene_voxel_m: 0.005, "
-      "outlier_neighbours: 8, icp_iterations: [0, 0, 2]}\n"
+      "outlier_neighbours: 8, icp_iterations: [0, 0, 2], reacquire_within_s: 0.05}\n"
       "      - {type: bench_pipeline_probe, name: probe}\n";
   std::ostringstream y;
   y << "# Written by avs bench pipeline (tools/avs/pipeline_bench.cpp).\n"

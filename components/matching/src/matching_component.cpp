@@ -158,6 +158,12 @@ class MatchingComponent final : public runtime::Component {
             .integer("min_scene_points", AVS_FIELD(pipeline.tracker.min_scene_points), 3, 100000,
                      "", "fewer S-PCD points: no match (counts as a failure)")
             .live()
+            .real("reacquire_within_s", AVS_FIELD(pipeline.tracker.reacquire_within_s), 0.0, 10.0,
+                  "s",
+                  "a lost target whose last valid pose is at most this old is first found again "
+                  "by ICP from that pose (held to the initial inlier ratio), before an initial "
+                  "alignment (0: off, every loss re-initialises)")
+            .live()
             .integer("max_border_pixels", AVS_FIELD(pipeline.max_border_pixels), -1, 100000, "px",
                      "target-window pixels on the image border above which the target is cut "
                      "off: no pose, re-initialise when whole (-1: off)")
@@ -260,7 +266,8 @@ class MatchingComponent final : public runtime::Component {
   void on_deactivate() override {
     log().info(images_, " depth images (", aged_images_, " with their /depth/info age), ", poses_,
                " poses, ", world_poses_, " world poses, ", initialisations_,
-               " initial alignments, state ", to_string(pipeline_->tracker().state()));
+               " initial alignments, ", reacquisitions_, " re-acquisitions, state ",
+               to_string(pipeline_->tracker().state()));
     if (report_dir_.empty()) return;
     const std::string file = report_dir_ + "/" + context().name() + ".csv";
     std::ofstream out(file);
@@ -347,6 +354,7 @@ class MatchingComponent final : public runtime::Component {
     const PipelineOutput out =
         age ? pipeline_->process(depth, stamp_s, *age) : pipeline_->process(depth, stamp_s);
     if (out.track.initialised_this_frame) ++initialisations_;
+    if (out.track.reacquired_this_frame) ++reacquisitions_;
 
     std::optional<Eigen::Isometry3d> T_world_model;
     if (out.has_pose) {
@@ -482,6 +490,7 @@ class MatchingComponent final : public runtime::Component {
   bool warned_no_joints_ = false;
   bool warned_joint_names_ = false;
   std::uint64_t images_ = 0, aged_images_ = 0, poses_ = 0, world_poses_ = 0, initialisations_ = 0;
+  std::uint64_t reacquisitions_ = 0;
   std::string csv_;
 };
 

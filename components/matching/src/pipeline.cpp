@@ -142,7 +142,8 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
   out.T_camera_model = out.track.T_camera_model;
 
   // Pose history for the velocity estimate: valid tracked poses only, within the window.
-  if (out.track.state != TrackingState::tracking || out.track.initialised_this_frame) {
+  if (out.track.state != TrackingState::tracking || out.track.initialised_this_frame ||
+      out.track.reacquired_this_frame) {
     history_.clear();
   }
   if (out.track.pose_valid) {

@@ -60,6 +60,7 @@ void Tracker::retune(const TrackerConfig& config) {
   config_.failures_before_loss = config.failures_before_loss;
   config_.min_scene_points = config.min_scene_points;
   config_.constant_velocity = config.constant_velocity;
+  config_.reacquire_within_s = config.reacquire_within_s;
 }
 
 void Tracker::reset() {
@@ -67,6 +68,14 @@ void Tracker::reset() {
   failures_ = 0;
   last_pose_.reset();
   previous_pose_.reset();
+  last_valid_pose_.reset();
+}
+
+bool Tracker::passes(const IcpResult& icp, bool as_initial) const {
+  const float min_inliers =
+      as_initial ? std::max(config_.min_inlier_ratio, config_.min_initial_inlier_ratio)
+                 : config_.min_inlier_ratio;
+  return icp.valid && icp.rmse_m <= config_.max_rmse_m && icp.inlier_ratio() >= min_inliers;
 }
 
 Eigen::Isometry3f Tracker::predict(double stamp_s) const {
@@ -95,38 +104,49 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
     return result;
   }
 
-  // 1. Pose guess: initial alignment when not tracking, else prediction from the last poses.
-  Eigen::Isometry3f guess;
+  // 1. Pose guess: when not tracking, re-acquisition from the last valid pose (when recent)
+  //    or else the initial alignment; when tracking, the prediction from the last poses.
+  bool as_initial = false;  // held to the initial alignment's inlier ratio
   if (state_ != TrackingState::tracking) {
-    last_initial_ = initial_.align(p_camera);
-    result.initialised_this_frame = true;
-    if (!last_initial_.valid) {
-      result.state = state_;
-      return result;
+    as_initial = true;
+    previous_pose_.reset();  // no velocity across a loss
+    const double since_valid_s = stamp_s - last_valid_stamp_s_;
+    if (state_ == TrackingState::lost && last_valid_pose_ && config_.reacquire_within_s > 0.0 &&
+        since_valid_s >= 0.0 && since_valid_s <= config_.reacquire_within_s) {
+      IcpResult icp = icp_.align(p_camera, *last_valid_pose_);
+      if (passes(icp, true)) {
+        result.reacquired_this_frame = true;
+        result.icp = std::move(icp);
+      }
     }
-    guess = last_initial_.T_camera_model;
-    previous_pose_.reset();
+    if (!result.reacquired_this_frame) {
+      last_initial_ = initial_.align(p_camera);
+      result.initialised_this_frame = true;
+      if (!last_initial_.valid) {
+        result.state = state_;
+        return result;
+      }
+      // 2. Fixed-count ICP from the guess.
+      result.icp = icp_.align(p_camera, last_initial_.T_camera_model);
+    }
   } else {
-    guess = predict(stamp_s);
+    // 2. Fixed-count ICP from the guess.
+    result.icp = icp_.align(p_camera, predict(stamp_s));
   }
-
-  // 2. Fixed-count ICP from the guess.
-  result.icp = icp_.align(p_camera, guess);
   result.T_camera_model = result.icp.T_camera_model;
-  result.pose_valid = result.icp.valid && result.icp.rmse_m <= config_.max_rmse_m &&
-                      result.icp.inlier_ratio() >= (result.initialised_this_frame
-                                                        ? std::max(config_.min_inlier_ratio,
-                                                                   config_.min_initial_inlier_ratio)
-                                                        : config_.min_inlier_ratio);
+  result.pose_valid = passes(result.icp, as_initial);
 
   // 3. State machine: failures in a row declare the target lost; a lost target re-initialises.
   if (result.pose_valid) {
     failures_ = 0;
     state_ = TrackingState::tracking;
+    last_valid_pose_ = result.T_camera_model;
+    last_valid_stamp_s_ = stamp_s;
     previous_pose_ = last_pose_;
     previous_stamp_s_ = last_stamp_s_;
     last_pose_ = result.T_camera_model;
     last_stamp_s_ = stamp_s;
+    if (result.reacquired_this_frame) previous_pose_.reset();  // no velocity across the gap
   } else if (state_ == TrackingState::tracking) {
     if (++failures_ >= config_.failures_before_loss) {
       state_ = TrackingState::lost;

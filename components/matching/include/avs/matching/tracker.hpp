@@ -34,6 +34,14 @@ struct TrackerConfig {
   float min_initial_inlier_ratio = 0.6F;
   int failures_before_loss = 3;       ///< consecutive failures that declare the target lost
   std::size_t min_scene_points = 15;  ///< fewer: no update (counts as a failure)
+  /// A lost target whose last valid pose is at most this old (s) is first re-acquired by ICP
+  /// from that pose, held to the initial alignment's inlier ratio; only when that fails does
+  /// the initial alignment run. What loses a target on a rig is mostly a short gap in the
+  /// data (a dropped camera frame invalidates a bit for a whole cycle: n empty depth maps),
+  /// and the initial alignment costs 10-40 ms against one ICP's 0.3 ms (docs/realtime.md).
+  /// 0: off, every loss re-initialises (the paper's Sec. 6.1). A partly out-of-view target
+  /// (MatchingPipeline::process, truncated) is forgotten, never re-acquired.
+  double reacquire_within_s = 0.0;
 };
 
 enum class TrackingState { waiting, tracking, lost };
@@ -44,6 +52,7 @@ struct TrackResult {
   Eigen::Isometry3f T_camera_model = Eigen::Isometry3f::Identity();
   TrackingState state = TrackingState::waiting;
   bool initialised_this_frame = false;  ///< the initial alignment ran on this frame
+  bool reacquired_this_frame = false;   ///< a lost target was found again from its last pose
   bool pose_valid = false;              ///< this frame passed the RMSE / inlier checks
   IcpResult icp;                        ///< of this frame
 };
@@ -60,8 +69,8 @@ class Tracker {
 
   /// The per-frame checks from `config` (max_rmse_m, 0 = the model's spacing as at
   /// construction; min_inlier_ratio, failures_before_loss, min_scene_points,
-  /// constant_velocity), the state kept: what the matching component changes while it runs.
-  /// The ICP and initial-alignment settings and the ICP model need a new Tracker.
+  /// constant_velocity, reacquire_within_s), the state kept: what the matching component changes
+  /// while it runs. The ICP and initial-alignment settings and the ICP model need a new Tracker.
   void retune(const TrackerConfig& config);
 
   [[nodiscard]] TrackingState state() const { return state_; }
@@ -71,6 +80,9 @@ class Tracker {
 
  private:
   [[nodiscard]] Eigen::Isometry3f predict(double stamp_s) const;
+  /// The frame passes: ICP valid, RMSE and inlier ratio (the initial alignment's when
+  /// `as_initial`).
+  [[nodiscard]] bool passes(const IcpResult& icp, bool as_initial) const;
 
   TrackerConfig config_;
   float default_max_rmse_m_ = 0.0F;  ///< what max_rmse_m 0 stands for (the model's spacing)
@@ -80,6 +92,8 @@ class Tracker {
   int failures_ = 0;
   std::optional<Eigen::Isometry3f> last_pose_;
   std::optional<Eigen::Isometry3f> previous_pose_;
+  std::optional<Eigen::Isometry3f> last_valid_pose_;  ///< of the last frame that passed
+  double last_valid_stamp_s_ = 0.0;
   double last_stamp_s_ = 0.0;
   double previous_stamp_s_ = 0.0;
   InitialAlignmentResult last_initial_;
