@@ -9,6 +9,7 @@
 #include "avs/matching/distance_grid.hpp"
 #include "avs/matching/kd_tree.hpp"
 #include "avs/matching/model_cloud.hpp"
+#include "avs/matching/neighbour_grid.hpp"
 #include "avs/matching/scene_cloud.hpp"
 #include "avs/matching/synthetic.hpp"
 #include "avs/matching/voxel_grid.hpp"
@@ -136,6 +137,52 @@ TEST(SceneCloud, KeepsAThinPartOfASmallCloud) {
   const Points kept = remove_outliers(points, 20, 0.03F);
   EXPECT_EQ(kept.size(), 67U);
   for (const auto& p : kept) EXPECT_LT(p.z(), 0.6F);
+}
+
+// The S-PCD outlier test's grid search gives the kd-tree's k nearest distances exactly, closest
+// first: clouds in a box, on a surface (the S-PCD's case), with duplicates and a far outlier,
+// queries from the cloud and from outside its box, k larger than the cloud.
+TEST(NeighbourGrid, GivesTheKdTreesNearestDistancesExactly) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-0.1F, 0.1F);
+  std::vector<Points> clouds;
+  Points box, surface, duplicates;
+  for (int i = 0; i < 400; ++i) box.emplace_back(u(rng), u(rng), 0.8F + u(rng));
+  for (int i = 0; i < 500; ++i) {
+    const float x = u(rng), y = u(rng);
+    surface.emplace_back(x, y, 0.9F + 0.3F * x * x - 0.2F * y);
+  }
+  surface.emplace_back(0.4F, -0.3F, 1.4F);  // an outlier far from the rest
+  for (int i = 0; i < 60; ++i)
+    duplicates.emplace_back(0.01F * static_cast<float>(i % 7), 0.0F, 1.0F);
+  clouds = {box, surface, duplicates, Points{Eigen::Vector3f(0.1F, 0.2F, 0.3F)}};
+  NeighbourGrid grid;
+  for (const Points& cloud : clouds) {
+    grid.rebuild(cloud);
+    const KdTree tree(cloud);
+    Points queries = cloud;
+    queries.emplace_back(1.0F, 1.0F, 3.0F);
+    queries.emplace_back(-0.5F, 0.0F, 0.9F);
+    for (const std::size_t k :
+         {std::size_t{1}, std::size_t{9}, std::size_t{21}, cloud.size() + 3}) {
+      std::vector<std::uint32_t> gi(k), ti(k);
+      std::vector<float> gd(k), td(k);
+      for (const auto& q : queries) {
+        const std::size_t gn = grid.knn(q, k, gi.data(), gd.data());
+        const std::size_t tn = tree.knn(q, k, ti.data(), td.data());
+        ASSERT_EQ(gn, tn) << "k " << k << ", cloud of " << cloud.size();
+        for (std::size_t j = 0; j < gn; ++j) {
+          ASSERT_EQ(gd[j], td[j]) << "neighbour " << j << " of k " << k << ", cloud of "
+                                  << cloud.size();
+          ASSERT_NEAR((cloud[gi[j]] - q).squaredNorm(), gd[j], 1e-6F * gd[j] + 1e-12F);
+        }
+      }
+    }
+  }
+  grid.rebuild(Points{});
+  std::uint32_t index = 0;
+  float distance = 0;
+  EXPECT_EQ(grid.knn(Eigen::Vector3f::Zero(), 3, &index, &distance), 0U) << "empty cloud";
 }
 
 TEST(DistanceGrid, AgreesWithTheClosestPoint) {

@@ -73,15 +73,6 @@ void KdTree::build(Points points) {
   if (!points_.empty()) index_ = std::make_unique<Index>(&points_);
 }
 
-void KdTree::rebuild(const Points& points) {
-  points_.assign(points.begin(), points.end());
-  if (!index_) {
-    index_ = std::make_unique<Index>(&points_);  // builds the index
-  } else {
-    index_->tree.buildIndex();
-  }
-}
-
 std::pair<std::uint32_t, float> KdTree::nearest(const Eigen::Vector3f& query) const {
   if (!index_ || points_.empty()) throw std::logic_error("KdTree::nearest on an empty tree");
   NearestResult result;

@@ -62,6 +62,7 @@ MatchingPipeline::MatchingPipeline(ModelCloud model, PipelineConfig config)
       tracker_(model_, config_.tracker),
       scene_(&empty_) {
   check_settings(config_, "MatchingPipeline: ");
+  history_.reserve(64);
 }
 
 void MatchingPipeline::retune(const PipelineConfig& config) {
@@ -149,7 +150,7 @@ PipelineOutput MatchingPipeline::process(const DepthView& depth, double stamp_s,
   if (out.track.pose_valid) {
     history_.push_back({data_stamp_s, out.track.T_camera_model});
     while (history_.size() > 2 && data_stamp_s - history_[1].stamp_s >= config_.velocity_window_s) {
-      history_.pop_front();
+      history_.erase(history_.begin());
     }
   }
   if (config_.lag_compensation_s > 0.0 && lag_s > 0.0 && out.has_pose && history_.size() >= 2) {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "avs/matching/kd_tree.hpp"
+#include "avs/matching/neighbour_grid.hpp"
 
 namespace avs::matching {
 namespace {
@@ -15,7 +15,7 @@ bool usable(float z, const SceneCloudConfig& config) {
 }
 
 void remove_outliers_into(const Points& in, std::size_t neighbours, float threshold_m, Points& out,
-                          KdTree& tree, std::vector<std::uint32_t>& indices,
+                          NeighbourGrid& grid, std::vector<std::uint32_t>& indices,
                           std::vector<float>& squared) {
   out.clear();
   if (in.size() <= 1 || neighbours == 0) {
@@ -26,11 +26,11 @@ void remove_outliers_into(const Points& in, std::size_t neighbours, float thresh
   // voxel step) 20 neighbours reach across the object and a thin part (its spike) would be taken
   // for outliers. Clouds of 240 points or more use `neighbours` as given.
   neighbours = std::min(neighbours, std::max<std::size_t>(4, in.size() / 12));
-  tree.rebuild(in);  // small (a few hundred points); the build is a few microseconds
+  grid.rebuild(in);  // small (a few hundred points); no allocation once the buffers have grown
   indices.resize(neighbours + 1);
   squared.resize(neighbours + 1);
   for (const auto& p : in) {
-    const std::size_t found = tree.knn(p, neighbours + 1, indices.data(), squared.data());
+    const std::size_t found = grid.knn(p, neighbours + 1, indices.data(), squared.data());
     double sum = 0.0;
     for (std::size_t k = 1; k < found; ++k) sum += std::sqrt(static_cast<double>(squared[k]));
     const double mean = found > 1 ? sum / static_cast<double>(found - 1) : 0.0;
@@ -112,17 +112,17 @@ const Points& SceneCloudBuilder::build(const DepthView& depth, const MaskView& m
 
   // 4. Outliers: mean distance to the k nearest neighbours above the threshold.
   remove_outliers_into(voxels_, config_.outlier_neighbours, config_.outlier_mean_distance_m,
-                       result_, knn_tree_, knn_indices_, knn_squared_);
+                       result_, knn_grid_, knn_indices_, knn_squared_);
   return result_;
 }
 
 Points remove_outliers(const Points& points, std::size_t neighbours,
                        float mean_distance_threshold_m) {
   Points out;
-  KdTree tree;
+  NeighbourGrid grid;
   std::vector<std::uint32_t> indices;
   std::vector<float> squared;
-  remove_outliers_into(points, neighbours, mean_distance_threshold_m, out, tree, indices, squared);
+  remove_outliers_into(points, neighbours, mean_distance_threshold_m, out, grid, indices, squared);
   return out;
 }
 

@@ -24,11 +24,6 @@ class KdTree {
 
   /// Rebuilds the tree over new points.
   void build(Points points);
-  /// Rebuilds the tree over a copy of `points` in this tree's own buffer, keeping the index
-  /// object: once the buffer has grown to the largest cloud, the only allocation left is
-  /// nanoflann's node pool, which frees its blocks and mallocs them again on every build
-  /// (nanoflann 1.4's PooledAllocator). For a per-frame tree (the S-PCD outlier test).
-  void rebuild(const Points& points);
 
   [[nodiscard]] const Points& points() const { return points_; }
   [[nodiscard]] std::size_t size() const { return points_.size(); }

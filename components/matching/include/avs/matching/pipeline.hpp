@@ -6,8 +6,8 @@
 #pragma once
 
 #include <cstddef>
-#include <deque>
 #include <string>
+#include <vector>
 
 #include "avs/geometry/mesh.hpp"
 #include "avs/matching/border_regions.hpp"
@@ -113,7 +113,9 @@ class MatchingPipeline {
     double stamp_s;
     Eigen::Isometry3f T_camera_model;
   };
-  std::deque<Stamped> history_;
+  /// Oldest first. A vector (the front erased in place: a window of a few dozen poses), not a
+  /// deque, which mallocs and frees a block every few poses (no allocation per frame, issue 16).
+  std::vector<Stamped> history_;
 };
 
 /// A matching object: mesh, M-PCD size, i_number and symmetry (for error statistics only).

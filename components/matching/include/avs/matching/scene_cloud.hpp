@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "avs/matching/cloud.hpp"
-#include "avs/matching/kd_tree.hpp"
+#include "avs/matching/neighbour_grid.hpp"
 #include "avs/matching/voxel_grid.hpp"
 
 namespace avs::matching {
@@ -51,7 +51,7 @@ class SceneCloudBuilder {
   Points voxels_;
   Points result_;
   VoxelGridScratch scratch_;
-  KdTree knn_tree_;  ///< the outlier test's tree, rebuilt per frame in place
+  NeighbourGrid knn_grid_;  ///< the outlier test's neighbour search, rebuilt per frame in place
   std::vector<std::uint32_t> knn_indices_;
   std::vector<float> knn_squared_;
 };
