@@ -66,6 +66,8 @@ void Tracker::retune(const TrackerConfig& config) {
 void Tracker::reset() {
   state_ = TrackingState::waiting;
   failures_ = 0;
+  absent_failures_ = 0;
+  lost_to_absence_ = false;
   last_pose_.reset();
   previous_pose_.reset();
   last_valid_pose_.reset();
@@ -96,8 +98,12 @@ Eigen::Isometry3f Tracker::predict(double stamp_s) const {
 TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
   TrackResult result;
   if (p_camera.size() < config_.min_scene_points) {
-    if (state_ == TrackingState::tracking && ++failures_ >= config_.failures_before_loss) {
-      state_ = TrackingState::lost;
+    if (state_ == TrackingState::tracking) {
+      ++absent_failures_;
+      if (++failures_ >= config_.failures_before_loss) {
+        state_ = TrackingState::lost;
+        lost_to_absence_ = absent_failures_ == failures_;
+      }
     }
     result.state = state_;
     if (last_pose_) result.T_camera_model = *last_pose_;
@@ -111,8 +117,9 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
     as_initial = true;
     previous_pose_.reset();  // no velocity across a loss
     const double since_valid_s = stamp_s - last_valid_stamp_s_;
-    if (state_ == TrackingState::lost && last_valid_pose_ && config_.reacquire_within_s > 0.0 &&
-        since_valid_s >= 0.0 && since_valid_s <= config_.reacquire_within_s) {
+    if (state_ == TrackingState::lost && lost_to_absence_ && last_valid_pose_ &&
+        config_.reacquire_within_s > 0.0 && since_valid_s >= 0.0 &&
+        since_valid_s <= config_.reacquire_within_s) {
       IcpResult icp = icp_.align(p_camera, *last_valid_pose_);
       if (passes(icp, true)) {
         result.reacquired_this_frame = true;
@@ -139,6 +146,8 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
   // 3. State machine: failures in a row declare the target lost; a lost target re-initialises.
   if (result.pose_valid) {
     failures_ = 0;
+    absent_failures_ = 0;
+    lost_to_absence_ = false;
     state_ = TrackingState::tracking;
     last_valid_pose_ = result.T_camera_model;
     last_valid_stamp_s_ = stamp_s;
@@ -150,6 +159,7 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
   } else if (state_ == TrackingState::tracking) {
     if (++failures_ >= config_.failures_before_loss) {
       state_ = TrackingState::lost;
+      lost_to_absence_ = false;  // the data was there and did not fit: re-initialise
       previous_pose_.reset();
     } else {
       previous_pose_ = last_pose_;
@@ -159,6 +169,7 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
     }
   } else {
     state_ = TrackingState::lost;
+    lost_to_absence_ = false;  // a re-acquisition or initial alignment failed: start afresh
   }
   result.state = state_;
   return result;

@@ -34,13 +34,16 @@ struct TrackerConfig {
   float min_initial_inlier_ratio = 0.6F;
   int failures_before_loss = 3;       ///< consecutive failures that declare the target lost
   std::size_t min_scene_points = 15;  ///< fewer: no update (counts as a failure)
-  /// A lost target whose last valid pose is at most this old (s) is first re-acquired by ICP
-  /// from that pose, held to the initial alignment's inlier ratio; only when that fails does
-  /// the initial alignment run. What loses a target on a rig is mostly a short gap in the
-  /// data (a dropped camera frame invalidates a bit for a whole cycle: n empty depth maps),
-  /// and the initial alignment costs 10-40 ms against one ICP's 0.3 ms (docs/realtime.md).
-  /// 0: off, every loss re-initialises (the paper's Sec. 6.1). A partly out-of-view target
-  /// (MatchingPipeline::process, truncated) is forgotten, never re-acquired.
+  /// A target lost to missing data only (every failure that lost it had fewer than
+  /// min_scene_points) whose last valid pose is at most this old (s) is first re-acquired by
+  /// ICP from that pose, held to the initial alignment's inlier ratio; only when that fails
+  /// does the initial alignment run. On a rig a dropped camera frame invalidates a bit for a
+  /// whole cycle (n empty depth maps), and the initial alignment costs 10-40 ms against one
+  /// ICP's 0.3 ms (docs/realtime.md). A target lost while its data was there (ICP failed: an
+  /// occluder, a fast motion) re-initialises as before: re-acquiring those kept flipped poses
+  /// (avs experiments occlusion, 1073 flipped updates). 0: off, every loss re-initialises
+  /// (the paper's Sec. 6.1). A partly out-of-view target (MatchingPipeline::process,
+  /// truncated) is forgotten, never re-acquired.
   double reacquire_within_s = 0.0;
 };
 
@@ -90,6 +93,8 @@ class Tracker {
   InitialAligner initial_;
   TrackingState state_ = TrackingState::waiting;
   int failures_ = 0;
+  int absent_failures_ = 0;       ///< of failures_, frames with too few scene points
+  bool lost_to_absence_ = false;  ///< every failure that lost the target was missing data
   std::optional<Eigen::Isometry3f> last_pose_;
   std::optional<Eigen::Isometry3f> previous_pose_;
   std::optional<Eigen::Isometry3f> last_valid_pose_;  ///< of the last frame that passed
