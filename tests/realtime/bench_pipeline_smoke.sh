@@ -55,10 +55,12 @@ done
 grep -q "read 90 frames (5 cycles of 18) of .*closed_loop.mcap" "$W/bench.log" ||
   fail "the source did not read 5 whole cycles of the recording"
 
-# The table form, replaying that recording (--bag): the paper beside ours, and the load average.
+# The table form, replaying that recording (--bag) beside a CPU hog (--cpu-load): the paper
+# beside ours, and the load average.
 "$AVS" bench pipeline --seconds=1 --recorded-frames=90 --placements=intra_process \
-  --bag="$W/out/closed_loop.mcap" --dir="$W/out2" >"$W/table.txt" 2>"$W/bench.log" ||
+  --bag="$W/out/closed_loop.mcap" --cpu-load=1 --dir="$W/out2" >"$W/table.txt" 2>"$W/bench.log" ||
   fail "avs bench pipeline (table) failed"
+grep -q "1 CPU hog process(es) beside it" "$W/table.txt" || fail "the CPU hog is not said"
 [ -e "$W/out2/closed_loop.mcap" ] && fail "--bag recorded the closed loop again"
 grep -q "recorded in the closed loop: $W/out/closed_loop.mcap" "$W/table.txt" ||
   fail "the table does not name the recording replayed"

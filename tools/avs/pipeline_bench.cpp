@@ -8,6 +8,7 @@
 //   shm            the same through iceoryx shared memory (RouDi started by the bench)
 // The Cyclone configuration is the one a deployment generates for one host on `lo` (what
 // `avs launch` gives its containers), as in `avs bench transport`.
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -163,6 +165,7 @@ struct Options {
   double seconds = 30;
   int recorded_frames = 1008;
   Source source = Source::closed_loop;
+  int cpu_load = 0;  ///< busy processes beside the bench (overload, section 3)
   fs::path bag;  ///< a recording to replay; empty with closed_loop: record <dir>/closed_loop.mcap
   std::vector<std::string> placements{"intra_process", "udp", "shm"};
   fs::path dir = "avs_bench_pipeline";
@@ -187,7 +190,9 @@ Options parse_options(const std::vector<std::string>& raw) {
         "                        stamp 0.5 s; record one with avs launch closed_loop.yaml and\n"
         "                        avs bag record /camera/pattern: lockstep waits for the recorder)\n"
         "  --source=still_head   frames rendered with the head still: the ken leaves the view\n"
-        "                        in mid-swing (the bench before 2026-12-06)\n");
+        "                        in mid-swing (the bench before 2026-12-06)\n"
+        "  --cpu-load=N          N processes that spin on the CPU during the placements (an\n"
+        "                        overloaded host: stages skip to the newest input and count it)\n");
     std::exit(0);
   }
   o.seconds = given.number("--seconds", o.seconds, 0.1, 3600.0);
@@ -201,6 +206,7 @@ Options parse_options(const std::vector<std::string>& raw) {
                          "' (closed_loop, still_head)");
   }
   o.bag = given.text("--bag", "");
+  o.cpu_load = static_cast<int>(given.integer("--cpu-load", 0, 0, 64));
   if (!o.bag.empty() && o.source != Source::closed_loop) {
     throw runtime::Error(
         "avs bench pipeline: --bag replays a recording; --source=still_head "
@@ -580,6 +586,29 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
     record_closed_loop(o, o.bag, udp_xml, domain);
   }
 
+  // The CPU hogs: children that spin until the bench ends (SIGKILL below, or their parent's
+  // death: PR_SET_PDEATHSIG).
+  std::vector<pid_t> hogs;
+  for (int i = 0; i < o.cpu_load; ++i) {
+    const pid_t parent = getpid();
+    const pid_t pid = fork();
+    if (pid == 0) {
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (getppid() != parent) _exit(0);
+      for (;;) asm volatile("");  // spin (a side effect the compiler keeps)
+    }
+    if (pid > 0) hogs.push_back(pid);
+  }
+  struct KillHogs {
+    std::vector<pid_t>& pids;
+    ~KillHogs() {
+      for (const pid_t pid : pids) {
+        kill(pid, SIGKILL);
+        waitpid(pid, nullptr, 0);
+      }
+    }
+  } kill_hogs{hogs};
+
   bench::Report report;
   std::ostringstream title;
   const std::string load_before = bench::load_average();
@@ -588,7 +617,9 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
         << (o.source == Source::closed_loop ? "recorded in the closed loop: " + o.bag.string()
                                             : std::string("rendered, head still"))
         << "); "
-        << "load average before: " << load_before << " (2-core machine shared with builds)";
+        << "load average before: " << load_before << " (2-core machine shared with builds)"
+        << (o.cpu_load > 0 ? "; " + std::to_string(o.cpu_load) + " CPU hog process(es) beside it"
+                           : std::string());
   report.title = title.str();
   std::vector<PlacementResult> results;
   for (const std::string& placement : o.placements) {
@@ -622,6 +653,7 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
   report.json["seconds_per_placement"] = o.seconds;
   report.json["recorded_frames"] = o.recorded_frames;
   report.json["source_closed_loop"] = o.source == Source::closed_loop ? 1 : 0;
+  report.json["cpu_load_processes"] = o.cpu_load;
   report.json["load_average_1min_before"] = std::atof(load_before.c_str());
   report.json["load_average_1min_after"] = std::atof(bench::load_average().c_str());
   return report;
