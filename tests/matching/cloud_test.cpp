@@ -163,6 +163,7 @@ TEST(NeighbourGrid, GivesTheKdTreesNearestDistancesExactly) {
     Points queries = cloud;
     queries.emplace_back(1.0F, 1.0F, 3.0F);
     queries.emplace_back(-0.5F, 0.0F, 0.9F);
+    queries.emplace_back(1e7F, -3e6F, 0.5F);  // billions of cells away: clamped, never UB
     for (const std::size_t k :
          {std::size_t{1}, std::size_t{9}, std::size_t{21}, cloud.size() + 3}) {
       std::vector<std::uint32_t> gi(k), ti(k);

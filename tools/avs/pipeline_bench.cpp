@@ -14,11 +14,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -597,7 +599,11 @@ bench::Report pipeline_bench(const std::vector<std::string>& args) {
       if (getppid() != parent) _exit(0);
       for (;;) asm volatile("");  // spin (a side effect the compiler keeps)
     }
-    if (pid > 0) hogs.push_back(pid);
+    if (pid < 0) {
+      throw runtime::Error(std::string("avs bench pipeline: --cpu-load: cannot start a CPU hog: ") +
+                           std::strerror(errno));
+    }
+    hogs.push_back(pid);
   }
   struct KillHogs {
     std::vector<pid_t>& pids;

@@ -8,9 +8,12 @@ namespace {
 
 constexpr int kMaxCellsPerAxis = 64;
 
+/// The cell of a coordinate in cell units, clamped to [0, cells) before the conversion to int
+/// (a NaN or a coordinate billions of cells away must not reach it).
 int clamp_cell(float coordinate, int cells) {
-  const int c = static_cast<int>(std::floor(coordinate));
-  return std::clamp(c, 0, cells - 1);
+  if (!(coordinate > 0.0F)) return 0;
+  if (coordinate >= static_cast<float>(cells - 1)) return cells - 1;
+  return static_cast<int>(coordinate);
 }
 
 }  // namespace
@@ -26,9 +29,11 @@ void NeighbourGrid::rebuild(const Points& points) {
   }
   Eigen::Vector3f lo = points[0], hi = points[0];
   for (const auto& p : points) {
+    if (!p.allFinite()) continue;  // lands in a border cell; its distances are NaN anyway
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
+  if (!lo.allFinite() || !hi.allFinite()) lo = hi = Eigen::Vector3f::Zero();
   const Eigen::Vector3f extent = (hi - lo).cwiseMax(1e-6F);
   // About one point per cell if the cloud filled its box; never more than 64 cells an axis.
   const float volume = extent.x() * extent.y() * extent.z();
@@ -37,8 +42,7 @@ void NeighbourGrid::rebuild(const Points& points) {
   origin_ = lo;
   std::size_t total = 1;
   for (int a = 0; a < 3; ++a) {
-    cells_[a] =
-        std::clamp(static_cast<int>(std::floor(extent[a] / cell_m_)) + 1, 1, kMaxCellsPerAxis);
+    cells_[a] = clamp_cell(extent[a] / cell_m_, kMaxCellsPerAxis) + 1;  // 1 .. 64
     total *= static_cast<std::size_t>(cells_[a]);
   }
   // Counting sort of the points by cell (buffers keep their capacity from frame to frame).
@@ -115,9 +119,10 @@ std::size_t NeighbourGrid::knn(const Eigen::Vector3f& query, std::size_t k, std:
     // Every point not yet offered lies in a cell more than `ring` cells from the home cell
     // along some axis: at least `ring` whole cells from the query (which is in the home cell,
     // or beyond the box on the side of it where the home cell is the last).
+    // A thousandth of a cell less, for the rounding of the cell coordinates.
     if (found == k) {
-      const float reach = static_cast<float>(ring) * cell_m_;
-      if (squared_distances[k - 1] <= reach * reach) break;
+      const float reach = (static_cast<float>(ring) - 1e-3F) * cell_m_;
+      if (reach > 0.0F && squared_distances[k - 1] <= reach * reach) break;
     }
   }
   return found;

@@ -78,6 +78,7 @@ void MatchingPipeline::retune(const PipelineConfig& config) {
   config_.tracker.failures_before_loss = config.tracker.failures_before_loss;
   config_.tracker.min_scene_points = config.tracker.min_scene_points;
   config_.tracker.constant_velocity = config.tracker.constant_velocity;
+  config_.tracker.reacquire_within_s = config.tracker.reacquire_within_s;
   tracker_.retune(config.tracker);
 }
 

@@ -124,6 +124,8 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
       if (passes(icp, true)) {
         result.reacquired_this_frame = true;
         result.icp = std::move(icp);
+      } else {
+        lost_to_absence_ = false;  // not where it was lost: initial alignments from now on
       }
     }
     if (!result.reacquired_this_frame) {

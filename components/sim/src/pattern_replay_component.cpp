@@ -61,8 +61,9 @@ class PatternReplay final : public runtime::Component {
             "takes whole Gray-code cycles from a bag of /camera/pattern (or renders them from a "
             "scene, head still) once, then replays them "
             "(forwards and backwards by cycle, cycle numbers counting up) on /camera/pattern and "
-            "/head/joint_states at rate_hz on an absolute grid of the container clock; late "
-            "slots are counted, not sent late (avs bench pipeline)",
+            "/head/joint_states at rate_hz on an absolute grid of the container clock, each "
+            "frame stamped with its slot's time; a late tick hands over every frame due since "
+            "(counted), frames beyond buffer_count are lost (counted) (avs bench pipeline)",
         .parameters =
             {ParamSpec::string("scene", "manipulator_ken",
                                "scene YAML (docs/sim.md), looked up as sim_scene's scene"),
@@ -75,8 +76,8 @@ class PatternReplay final : public runtime::Component {
                              "scene time (bag: header stamp) of the first recorded frame; a bag "
                              "starts at the first cycle's first frame from this time on"),
              ParamSpec::integer("recorded_frames", 1008, 2, 100000, "",
-                                "frames rendered into memory (rounded down to whole cycles, at "
-                                "least one)"),
+                                "frames taken into memory, rendered or from the bag (rounded "
+                                "down to whole cycles, at least one)"),
              ParamSpec::real("rate_hz", 1000.0, 1.0, 100000.0, "Hz", "replay frame rate"),
              ParamSpec::integer("buffer_count", 32, 1, 4096, "",
                                 "frames exposed but not yet handed over that are kept (the "
