@@ -180,7 +180,8 @@ TEST(NeighbourGrid, GivesTheKdTreesNearestDistancesExactly) {
       }
     }
   }
-  grid.rebuild(Points{});
+  const Points empty;
+  grid.rebuild(empty);
   std::uint32_t index = 0;
   float distance = 0;
   EXPECT_EQ(grid.knn(Eigen::Vector3f::Zero(), 3, &index, &distance), 0U) << "empty cloud";

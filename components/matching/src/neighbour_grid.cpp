@@ -19,8 +19,8 @@ int clamp_cell(float coordinate, int cells) {
 }  // namespace
 
 void NeighbourGrid::rebuild(const Points& points) {
-  points_ = &points;
   const std::size_t n = points.size();
+  points_ = n == 0 ? nullptr : &points;  // an empty cloud is never read again
   if (n == 0) {
     cells_[0] = cells_[1] = cells_[2] = 1;
     cell_start_.assign(2, 0);
