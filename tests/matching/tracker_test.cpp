@@ -183,29 +183,47 @@ TEST(Tracker, WithoutReacquisitionOrAfterALongGapTheInitialAlignmentRuns) {
   EXPECT_EQ(late.after_gap.state, TrackingState::tracking);
 }
 
+// The cube tracked at `first` for two frames, re-acquisition on (1 s), loss after 2 failures;
+// `elsewhere` is a pose 9 cm away that per-frame ICP cannot reach from `first`.
+struct TrackedCube {
+  ObjectPreset cube = builtin_objects()[1];
+  ModelCloud model = test::model_of(cube);
+  Tracker tracker{model, config()};
+  Eigen::Isometry3f first = random_object_pose(4);
+  Eigen::Isometry3f elsewhere = moved_away(first);
+
+  static TrackerConfig config() {
+    TrackerConfig c;
+    c.failures_before_loss = 2;
+    c.reacquire_within_s = 1.0;
+    return c;
+  }
+  static Eigen::Isometry3f moved_away(const Eigen::Isometry3f& from) {
+    Eigen::Isometry3f to = random_object_pose(99);
+    to.translation() = from.translation() + Eigen::Vector3f(0.07F, -0.05F, 0.02F);
+    return to;
+  }
+  TrackResult see(const Eigen::Isometry3f& pose, std::uint32_t seed, double t_s) {
+    return tracker.update(test::scene_of(cube, model, pose, seed), t_s);
+  }
+  TrackedCube() {
+    see(first, 1, 0.0);
+    EXPECT_EQ(see(first, 2, 0.002).state, TrackingState::tracking);
+  }
+};
+
 // Re-acquisition is held to the initial alignment's check: a target that is not where it was
 // lost is not "found" near its old pose; the initial alignment finds where it is.
 TEST(Tracker, ReacquisitionDoesNotAcceptATargetThatMovedAway) {
-  const ObjectPreset cube = builtin_objects()[1];
-  const ModelCloud model = test::model_of(cube);
-  TrackerConfig config;
-  config.failures_before_loss = 2;
-  config.reacquire_within_s = 1.0;
-  Tracker tracker(model, config);
-  const Eigen::Isometry3f first = random_object_pose(4);
-  tracker.update(test::scene_of(cube, model, first, 1), 0.0);
-  ASSERT_EQ(tracker.update(test::scene_of(cube, model, first, 2), 0.002).state,
-            TrackingState::tracking);
-  tracker.update(Points{}, 0.004);
-  tracker.update(Points{}, 0.006);
-  ASSERT_EQ(tracker.state(), TrackingState::lost);
-  Eigen::Isometry3f second = random_object_pose(99);
-  second.translation() = first.translation() + Eigen::Vector3f(0.07F, -0.05F, 0.02F);
-  const TrackResult result = tracker.update(test::scene_of(cube, model, second, 7), 0.008);
+  TrackedCube t;
+  t.tracker.update(Points{}, 0.004);
+  t.tracker.update(Points{}, 0.006);
+  ASSERT_EQ(t.tracker.state(), TrackingState::lost);
+  const TrackResult result = t.see(t.elsewhere, 7, 0.008);
   EXPECT_FALSE(result.reacquired_this_frame);
   EXPECT_TRUE(result.initialised_this_frame);
   EXPECT_EQ(result.state, TrackingState::tracking);
-  const PoseError error = pose_error(result.T_camera_model, second, Symmetry::cube);
+  const PoseError error = pose_error(result.T_camera_model, t.elsewhere, Symmetry::cube);
   EXPECT_LT(error.rotation_deg, 5.0F);
   EXPECT_LT(error.translation_m, 0.005F);
 }
@@ -214,22 +232,11 @@ TEST(Tracker, ReacquisitionDoesNotAcceptATargetThatMovedAway) {
 // failed on it: an occluder, a jump) re-initialises, even when it comes back where it was (in
 // the occlusion experiment re-acquiring those kept a flipped pose for seconds).
 TEST(Tracker, ATargetLostWhileItsDataWasThereIsReinitialisedNotReacquired) {
-  const ObjectPreset cube = builtin_objects()[1];
-  const ModelCloud model = test::model_of(cube);
-  TrackerConfig config;
-  config.failures_before_loss = 2;
-  config.reacquire_within_s = 1.0;
-  Tracker tracker(model, config);
-  const Eigen::Isometry3f first = random_object_pose(4);
-  tracker.update(test::scene_of(cube, model, first, 1), 0.0);
-  ASSERT_EQ(tracker.update(test::scene_of(cube, model, first, 2), 0.002).state,
-            TrackingState::tracking);
-  Eigen::Isometry3f elsewhere = random_object_pose(99);
-  elsewhere.translation() = first.translation() + Eigen::Vector3f(0.07F, -0.05F, 0.02F);
-  tracker.update(test::scene_of(cube, model, elsewhere, 3), 0.004);
-  tracker.update(test::scene_of(cube, model, elsewhere, 4), 0.006);
-  ASSERT_EQ(tracker.state(), TrackingState::lost);
-  const TrackResult back = tracker.update(test::scene_of(cube, model, first, 5), 0.008);
+  TrackedCube t;
+  t.see(t.elsewhere, 3, 0.004);
+  t.see(t.elsewhere, 4, 0.006);
+  ASSERT_EQ(t.tracker.state(), TrackingState::lost);
+  const TrackResult back = t.see(t.first, 5, 0.008);
   EXPECT_FALSE(back.reacquired_this_frame);
   EXPECT_TRUE(back.initialised_this_frame);
   EXPECT_EQ(back.state, TrackingState::tracking);
