@@ -1,7 +1,7 @@
 // hidapi (hidraw backend) as a HidTransport. NOT exercised by avs's tests: no LightCrafter is
 // attached to the test machine (docs/devices.md section 7); the protocol above it is tested
 // against the emulator. hidapi's write takes the report id (0: the DLPC350 uses none) first.
-#include "hidapi_transport.hpp"
+#include "avs/projector/hidapi_transport.hpp"
 
 #include <hidapi/hidapi.h>
 

@@ -1,5 +1,5 @@
 // Built without hidapi (CMake warned): no USB transport; `transport: hid` fails with this.
-#include "hidapi_transport.hpp"
+#include "avs/projector/hidapi_transport.hpp"
 
 namespace avs::projector {
 

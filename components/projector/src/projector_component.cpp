@@ -18,7 +18,7 @@
 #include "avs/projector/projector_link.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
-#include "hidapi_transport.hpp"
+#include "avs/projector/hidapi_transport.hpp"
 
 namespace avs::projector {
 

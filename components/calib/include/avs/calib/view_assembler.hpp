@@ -1,0 +1,100 @@
+// Which calibration frame is this camera frame? (issue 14, `avs calib capture --source camera`)
+//
+// While a board pose is captured the projector loops the calibration sequence of
+// capture_frames() (white, black, column bits +/-, row bits +/-: N frames), one camera frame per
+// pattern, from any phase. A camera gives frame ids, not pattern numbers, so the assembler finds
+// the sequence in the images and never hands out a mislabelled view:
+//
+//   * It keeps a run of frames with consecutive ids (a gap in the ids starts a new run: a frame
+//     lost in transport would shift every label after it).
+//   * Phase: over any N consecutive frames (each pattern once) the white frame is the
+//     per-pixel maximum and the black frame the minimum, up to noise. The phase is the frame
+//     that, with the frame after it, is closest to (maximum, minimum), by a margin over every
+//     other pair of neighbours (`min_phase_margin`). A code bit whose positive lights all of the
+//     scene the projector reaches in view and whose negative lights none (a scene inside one
+//     half of the projector's image) would look the same: then the phase cannot be told from
+//     the images, and nothing is labelled. The projector must light at least
+//     `min_lit_fraction` of the image by `lit_threshold_dn`.
+//   * Structure: in the cycle from that white frame, every bit's positive and negative must be
+//     complementary where the projector lights the scene: mean |pos + neg - white - black| over
+//     lit pixels at most `max_pair_mismatch` of the mean (white - black). A slip of one frame
+//     without a trace in the ids fails here.
+//   * Stillness: the two white frames, one cycle apart, must agree (at most `max_moved_fraction`
+//     of the pixels differ by more than `moved_threshold_dn`): a board moved or shaken during
+//     the capture is refused, not averaged.
+//
+// The view is the first cycle's frames, as the camera gave them. Core: no I/O, no threads;
+// frames are copied into the assembler (a view is 36 frames, not a 500 Hz path).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "avs/calib/capture.hpp"
+#include "avs/decode/png_io.hpp"
+#include "avs/decode/rolling_decoder.hpp"
+
+namespace avs::calib {
+
+struct AssemblerConfig {
+  int frame_id_bits = 16;             ///< GigE Vision block ids: 16 bits (64: no wrap)
+  bool frame_id_zero_skipped = true;  ///< GigE Vision: id 0 is invalid, 65535 -> 1
+  int lit_threshold_dn = 8;           ///< white - black at least this: lit by the projector
+  double min_lit_fraction = 0.02;     ///< of the image, lit in the white -> black step
+  double max_pair_mismatch = 0.25;    ///< see the header comment
+  /// The white frame and the black one after it must be closer to the cycle's per-pixel
+  /// maximum and minimum (mean distance over lit pixels, as a fraction of the lit level
+  /// max - min) than any other two neighbours by this much, and each at most
+  /// max_phase_distance from it.
+  double min_phase_margin = 0.05;
+  double max_phase_distance = 0.15;
+  int moved_threshold_dn = 24;
+  double max_moved_fraction = 0.005;
+};
+
+/// What one push() gave.
+struct AssemblerResult {
+  /// A complete, checked view (frames in capture_frames() order, name and truth empty).
+  std::optional<BoardView> view;
+  /// Why a run of frames was given up ("" when none was): logged by the caller; the
+  /// assembler goes on with the frames after it.
+  std::string rejected;
+};
+
+class ViewAssembler {
+ public:
+  /// Frames of `width` x `height` 8-bit pixels, the sequence of `codes`.
+  ViewAssembler(const CaptureCodes& codes, int width, int height, AssemblerConfig config = {});
+
+  /// Takes one camera frame (copied). A frame of another size is rejected with its reason.
+  AssemblerResult push(std::uint64_t frame_id, const decode::ImageView8& image);
+  /// Forgets every frame (the board is about to move).
+  void reset();
+
+  int frames_per_cycle() const { return static_cast<int>(frames_.size()); }
+  std::int64_t frames_pushed() const { return pushed_; }
+
+ private:
+  bool follows(std::uint64_t previous, std::uint64_t id) const;
+  /// The white frame's index in the run's first cycle, or nullopt and why.
+  std::optional<std::size_t> find_white(std::string& why) const;
+  /// Checks the run from white frame `w`; "" when it is a good view.
+  std::string check_cycle(std::size_t w) const;
+
+  std::vector<FrameId> frames_;  ///< the sequence, capture_frames() order
+  int width_;
+  int height_;
+  AssemblerConfig config_;
+  std::vector<decode::GrayImage8> run_;  ///< consecutive frames, oldest first
+  std::optional<std::uint64_t> last_id_;
+  std::int64_t pushed_ = 0;
+};
+
+/// The projector image of one calibration frame (codes.projector_width x projector_height,
+/// 0 or 255): what the projector's flash holds for it (`avs calib patterns`) and what the
+/// simulator's projector shows.
+decode::GrayImage8 projector_pattern(const CaptureCodes& codes, const FrameId& frame);
+
+}  // namespace avs::calib

@@ -1,0 +1,207 @@
+// Issue 14, section 2 (`avs calib capture --source camera`): the ViewAssembler finds the
+// calibration sequence in a stream of camera frames at any phase and never hands out a view
+// whose frames are mislabelled: simulated board views (the renderer of `avs calib capture
+// --source sim`), streamed as a camera would give them.
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "avs/calib/bench.hpp"
+#include "avs/calib/view_assembler.hpp"
+
+namespace avs::calib {
+namespace {
+
+struct Views {
+  Views() {
+    sim::RendererConfig renderer;
+    renderer.geometry = bench_truth_geometry();
+    renderer.noise_sigma_dn = 2.0;
+    SimCapture capture(renderer, board);
+    info = capture.info();
+    const auto poses = generate_board_poses(renderer.geometry, board, 2, 0.6, 1.0, 20, 14);
+    a = capture.render(poses[0], 0, "a");
+    a_again = capture.render(poses[0], 1, "a");  // the same pose, other noise: the next cycle
+    b = capture.render(poses[1], 2, "b");
+  }
+  sim::Checkerboard board;
+  CaptureInfo info;
+  BoardView a, a_again, b;
+};
+
+const Views& views() {
+  static const Views v;
+  return v;
+}
+
+decode::ImageView8 view_of(const decode::GrayImage8& image) {
+  return {image.pixels.data(), image.width, image.height, 0};
+}
+
+/// Streams frames with ids from `first_id`; returns the first view assembled (and the
+/// rejections seen on the way).
+struct Fed {
+  std::optional<BoardView> view;
+  std::vector<std::string> rejected;
+  std::uint64_t next_id = 0;
+};
+Fed feed(ViewAssembler& assembler, const std::vector<const decode::GrayImage8*>& frames,
+         std::uint64_t first_id) {
+  Fed fed;
+  fed.next_id = first_id;
+  for (const decode::GrayImage8* f : frames) {
+    AssemblerResult r = assembler.push(fed.next_id, view_of(*f));
+    fed.next_id = fed.next_id == 65535 ? 1 : fed.next_id + 1;  // GigE Vision ids skip 0
+    if (!r.rejected.empty()) fed.rejected.push_back(r.rejected);
+    if (r.view) {
+      fed.view = std::move(r.view);
+      return fed;
+    }
+  }
+  return fed;
+}
+
+/// Cycles of `cycles` (one BoardView each), starting at frame `phase` of the first.
+std::vector<const decode::GrayImage8*> stream(const std::vector<const BoardView*>& cycles,
+                                              std::size_t phase) {
+  std::vector<const decode::GrayImage8*> out;
+  for (std::size_t c = 0; c < cycles.size(); ++c) {
+    for (std::size_t f = c == 0 ? phase : 0; f < cycles[c]->frames.size(); ++f) {
+      out.push_back(&cycles[c]->frames[f]);
+    }
+  }
+  return out;
+}
+
+void expect_frames_equal(const BoardView& got, const BoardView& want) {
+  ASSERT_EQ(got.frames.size(), want.frames.size());
+  for (std::size_t f = 0; f < want.frames.size(); ++f) {
+    EXPECT_EQ(got.frames[f].pixels, want.frames[f].pixels) << "frame " << f;
+  }
+}
+
+TEST(ViewAssembler, FindsTheSequenceAtEveryPhaseAcrossAnIdWrap) {
+  const Views& v = views();
+  const std::size_t n = v.a.frames.size();
+  ASSERT_EQ(n, 36u);  // white, black, 8 column bits and 9 row bits, each +/-
+  for (std::size_t phase = 0; phase < n; phase += 5) {
+    ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
+    // A cycle of the previous pose's last frames, then this pose's cycles; ids wrap 65535 -> 1.
+    const Fed fed =
+        feed(assembler, stream({&v.a, &v.a_again, &v.a, &v.a_again}, phase), 65535 - 20);
+    ASSERT_TRUE(fed.view) << "phase " << phase;
+    // The first whole cycle from a white frame.
+    expect_frames_equal(*fed.view, phase == 0 ? v.a : v.a_again);
+  }
+}
+
+TEST(ViewAssembler, AGapInTheIdsStartsAgainAndNeverShiftsTheLabels) {
+  const Views& v = views();
+  ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
+  std::vector<const decode::GrayImage8*> frames = stream({&v.a, &v.a_again, &v.a, &v.a_again}, 7);
+  // Frame 40 lost in transport (its id never arrives): the ids say so.
+  std::optional<BoardView> got;
+  std::vector<std::string> rejected;
+  std::uint64_t id = 100;
+  for (std::size_t k = 0; k < frames.size() && !got; ++k, ++id) {
+    if (k == 40) continue;
+    AssemblerResult r = assembler.push(id, view_of(*frames[k]));
+    if (!r.rejected.empty()) rejected.push_back(r.rejected);
+    got = std::move(r.view);
+  }
+  ASSERT_TRUE(got);
+  ASSERT_FALSE(rejected.empty());
+  EXPECT_NE(rejected[0].find("frames lost"), std::string::npos) << rejected[0];
+  // The run after the gap starts in the second cycle; its first white is the third cycle's.
+  expect_frames_equal(*got, v.a);
+}
+
+TEST(ViewAssembler, AFrameSlippedWithoutATraceInTheIdsIsCaughtByThePairs) {
+  const Views& v = views();
+  ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
+  // Frame 10 of each cycle lost, but the ids count on (a camera that missed a trigger and
+  // numbered the next exposure as if nothing happened): every cycle is one frame short.
+  std::vector<const decode::GrayImage8*> frames;
+  for (const BoardView* c : {&v.a, &v.a_again, &v.a, &v.a_again}) {
+    for (std::size_t f = 0; f < c->frames.size(); ++f) {
+      if (f != 10) frames.push_back(&c->frames[f]);
+    }
+  }
+  const Fed fed = feed(assembler, frames, 1);
+  EXPECT_FALSE(fed.view);
+  ASSERT_FALSE(fed.rejected.empty());
+  EXPECT_NE(fed.rejected[0].find("not the complementary pair"), std::string::npos)
+      << fed.rejected[0];
+}
+
+TEST(ViewAssembler, ABoardMovedDuringTheCaptureIsRefusedThenTheStillOneTaken) {
+  const Views& v = views();
+  ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
+  // Pose a for one cycle, then pose b (the board moved) for three.
+  const Fed fed = feed(assembler, stream({&v.a, &v.b, &v.b, &v.b}, 0), 1);
+  ASSERT_FALSE(fed.rejected.empty());
+  EXPECT_NE(fed.rejected[0].find("scene changed"), std::string::npos) << fed.rejected[0];
+  ASSERT_TRUE(fed.view);
+  expect_frames_equal(*fed.view, v.b);
+}
+
+TEST(ViewAssembler, NoProjectedSequenceGivesNoViewAndSaysWhy) {
+  const Views& v = views();
+  ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
+  // The projector off: the camera sees the black frame over and over.
+  std::vector<const decode::GrayImage8*> frames(200, &v.a.frames[1]);
+  const Fed fed = feed(assembler, frames, 1);
+  EXPECT_FALSE(fed.view);
+  ASSERT_FALSE(fed.rejected.empty());
+  EXPECT_NE(fed.rejected[0].find("calibration sequence"), std::string::npos) << fed.rejected[0];
+  // A frame of another size is refused with its size.
+  const std::vector<std::uint8_t> small(64 * 64);
+  const AssemblerResult r = assembler.push(999, {small.data(), 64, 64, 0});
+  EXPECT_NE(r.rejected.find("64 x 64"), std::string::npos) << r.rejected;
+}
+
+TEST(ViewAssembler, APatternThatLightsAllOfTheSceneLikeWhiteIsAmbiguousAndRefused) {
+  const Views& v = views();
+  ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
+  // Column bit 0 positive shows what white shows and its negative what black shows (a scene
+  // inside one half of the projector's image): two white -> black steps per cycle.
+  BoardView odd = v.a;
+  odd.frames[2] = v.a.frames[0];
+  odd.frames[3] = v.a.frames[1];
+  const Fed fed = feed(assembler, stream({&odd, &odd, &odd, &odd}, 0), 1);
+  EXPECT_FALSE(fed.view);
+  ASSERT_FALSE(fed.rejected.empty());
+  EXPECT_NE(fed.rejected[0].find("ambiguous"), std::string::npos) << fed.rejected[0];
+}
+
+TEST(ProjectorPattern, IsWhatTheSimulatorsProjectorShows) {
+  const CaptureCodes codes = calibration_codes(912, 1140, 4);
+  const std::vector<FrameId> frames = capture_frames(codes);
+  const decode::GrayImage8 white = projector_pattern(codes, frames[0]);
+  const decode::GrayImage8 black = projector_pattern(codes, frames[1]);
+  EXPECT_EQ(white.width, 912);
+  EXPECT_EQ(white.height, 1140);
+  EXPECT_EQ(std::count(white.pixels.begin(), white.pixels.end(), 255), 912 * 1140);
+  EXPECT_EQ(std::count(black.pixels.begin(), black.pixels.end(), 0), 912 * 1140);
+  // Column bit 0 (MSB) splits the coded columns in two halves; its negative lights the rest of
+  // the coded columns; the row code varies along y only.
+  const decode::GrayImage8 c0p = projector_pattern(codes, frames[2]);
+  const decode::GrayImage8 c0n = projector_pattern(codes, frames[3]);
+  const int x_low = codes.columns.first_row + 1,
+            x_high = codes.columns.first_row + codes.columns.used_rows() - 2;
+  EXPECT_NE(c0p.pixels[x_low], c0p.pixels[x_high]);
+  EXPECT_EQ(c0p.pixels[x_low] + c0n.pixels[x_low], 255);
+  const FrameId row_bit{FrameKind::kRowBit, codes.rows.bit_count - 1, true};
+  const decode::GrayImage8 r = projector_pattern(codes, row_bit);
+  for (int y = 0; y < r.height; y += 37) {
+    EXPECT_EQ(r.pixels[static_cast<std::size_t>(y) * 912],
+              r.pixels[static_cast<std::size_t>(y) * 912 + 600]);
+  }
+}
+
+}  // namespace
+}  // namespace avs::calib
