@@ -21,7 +21,7 @@ projector::SequenceConfig calibration_sequence(const CaptureCodes& codes, int pa
                                 " Hz is not a whole number of microseconds per pattern");
   }
   projector::SequenceConfig sequence;
-  sequence.pattern_count = static_cast<int>(capture_frames(codes).size());
+  sequence.pattern_count = static_cast<int>(projection_sequence(codes).size());
   sequence.frame_period_us = 1000000 / pattern_rate_hz;
   sequence.exposure_us = sequence.frame_period_us;
   sequence.first_flash_image = first_flash_image;

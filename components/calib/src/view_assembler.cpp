@@ -19,7 +19,7 @@ std::string frame_label(const FrameId& id) {
 
 ViewAssembler::ViewAssembler(const CaptureCodes& codes, int width, int height,
                              AssemblerConfig config)
-    : frames_(capture_frames(codes)), width_(width), height_(height), config_(config) {
+    : frames_(projection_sequence(codes)), width_(width), height_(height), config_(config) {
   if (width < 1 || height < 1) throw std::invalid_argument("calib::ViewAssembler: empty frames");
   if (config.frame_id_bits < 1 || config.frame_id_bits > 64) {
     throw std::invalid_argument("calib::ViewAssembler: frame_id_bits must be 1..64");
@@ -72,14 +72,33 @@ AssemblerResult ViewAssembler::push(std::uint64_t frame_id, const decode::ImageV
   // needs the frame N after it (the next white) too.
   const std::size_t n = frames_.size();
   if (run_.size() < 2 * n + 1) return result;
+  // Every phase consistent with the whole sequence; one is a view, more are ambiguous.
   std::string why;
-  const std::optional<std::size_t> white = find_white(why);
-  if (white) why = check_cycle(*white);
-  if (white && why.empty()) {
-    const std::size_t best = *white;
-    BoardView view;
-    view.frames.assign(
-        std::make_move_iterator(run_.begin() + static_cast<std::ptrdiff_t>(best)),
+  std::vector<std::size_t> consistent;
+  for (const std::size_t w : white_candidates(why)) {
+    const std::string problem = check_cycle(w);
+    if (problem.empty()) {
+      consistent.push_back(w);
+    } else if (consistent.empty() && why.empty()) {
+      why = problem;  // the best candidate's
+    }
+  }
+  if (consistent.size() > 1) {
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "ambiguous sequence: frames %zu and %zu of a cycle both start a consistent "
+                  "calibration sequence (a code bit lights all of the scene the projector "
+                  "reaches in view, and its neighbours fit too): the projector must light more of "
+                  "the scene (board nearer the middle of its image, or a background)",
+                  consistent[0], consistent[1]);
+    why = text;
+  } else if (consistent.size() == 1) {
+    const std::size_t best = consistent[0];
+    BoardView view;  // the first white frame, then black and the codes
+    view.frames.push_back(std::move(run_[best]));
+    view.frames.insert(
+        view.frames.end(),
+        std::make_move_iterator(run_.begin() + static_cast<std::ptrdiff_t>(best + kWhiteFrames)),
         std::make_move_iterator(run_.begin() + static_cast<std::ptrdiff_t>(best + n)));
     result.view = std::move(view);
     run_.clear();
@@ -92,13 +111,10 @@ AssemblerResult ViewAssembler::push(std::uint64_t frame_id, const decode::ImageV
   return result;
 }
 
-std::optional<std::size_t> ViewAssembler::find_white(std::string& why) const {
-  // Over one cycle's frames (any N consecutive frames show each pattern once), the white frame
-  // is the per-pixel maximum and the black one the minimum, up to noise. The phase is the frame
-  // that, with the frame after it, is closest to (maximum, minimum), if clearly closer than
-  // any other frame. A code bit whose positive lights all of the scene the projector reaches in
-  // view, and its negative none, would be as close: then the phase cannot be told from the
-  // images and nothing is labelled.
+std::vector<std::size_t> ViewAssembler::white_candidates(std::string& why) const {
+  // Over one cycle's frames (any N consecutive frames show each pattern once), the white frames
+  // are the per-pixel maximum and the black one the minimum, up to noise. Candidates: where
+  // kWhiteFrames frames near the maximum are followed by one near the minimum, best first.
   const std::size_t n = frames_.size();
   const std::size_t pixels = run_[0].pixels.size();
   std::vector<std::uint8_t> hi(pixels, 0), lo(pixels, 255);
@@ -124,7 +140,7 @@ std::optional<std::size_t> ViewAssembler::find_white(std::string& why) const {
                   "projector running the calibration sequence, and lighting the board?",
                   100.0 * lit.size() / pixels, 100 * config_.min_lit_fraction);
     why = text;
-    return std::nullopt;
+    return {};
   }
   lit_level /= static_cast<double>(lit.size());
   std::vector<double> below_max(n), above_min(n);
@@ -138,43 +154,42 @@ std::optional<std::size_t> ViewAssembler::find_white(std::string& why) const {
     below_max[f] = a / static_cast<double>(lit.size()) / lit_level;
     above_min[f] = b / static_cast<double>(lit.size()) / lit_level;
   }
-  // Each frame f as the white frame: how far f is below the maximum plus how far f + 1 is
-  // above the minimum. Frame n's pattern is frame 0's.
+  // Each frame f as the first white frame: how far the white frames from f are below the
+  // maximum plus how far the black one after them is above the minimum (frame n is frame 0).
+  const std::size_t k = kWhiteFrames;
   std::vector<double> score(n);
-  for (std::size_t f = 0; f < n; ++f) score[f] = below_max[f] + above_min[(f + 1) % n];
-  std::size_t w = 0;
-  for (std::size_t f = 1; f < n; ++f) w = score[f] < score[w] ? f : w;
-  double second = 1e9;
-  for (std::size_t f = 0; f < n; ++f) second = f != w ? std::min(second, score[f]) : second;
-  if (second - score[w] < config_.min_phase_margin) {
-    std::snprintf(
-        text, sizeof text,
-        "ambiguous sequence: frames %zu and %zu of the cycle both look like white "
-        "then black (margin %.3f of the lit level, at least %.3f): a code bit lights "
-        "all of the scene the projector reaches in view; the projector must light "
-        "more of the scene (board nearer the middle of its image, or a background)",
-        w, static_cast<std::size_t>(std::find(score.begin(), score.end(), second) - score.begin()),
-        second - score[w], config_.min_phase_margin);
-    why = text;
-    return std::nullopt;
+  std::vector<std::size_t> candidates;
+  for (std::size_t f = 0; f < n; ++f) {
+    double worst_white = 0;
+    for (std::size_t j = 0; j < k; ++j) {
+      score[f] += below_max[(f + j) % n];
+      worst_white = std::max(worst_white, below_max[(f + j) % n]);
+    }
+    score[f] += above_min[(f + k) % n];
+    if (worst_white <= config_.max_phase_distance &&
+        above_min[(f + k) % n] <= config_.max_phase_distance) {
+      candidates.push_back(f);
+    }
   }
-  const double worst = config_.max_phase_distance;
-  if (below_max[w] > worst || above_min[(w + 1) % n] > worst) {
+  std::sort(candidates.begin(), candidates.end(),
+            [&score](std::size_t a, std::size_t b) { return score[a] < score[b]; });
+  if (candidates.empty()) {
+    std::size_t w = 0;
+    for (std::size_t f = 1; f < n; ++f) w = score[f] < score[w] ? f : w;
     std::snprintf(text, sizeof text,
-                  "no white frame followed by a black one (best: %.2f below the maximum, %.2f "
-                  "above the minimum, of the lit level; at most %.2f): not the calibration "
-                  "sequence (white, black, codes)",
-                  below_max[w], above_min[(w + 1) % n], worst);
+                  "no %zu white frames followed by a black one (best: %.2f below the maximum "
+                  "and %.2f above the minimum, of the lit level; at most %.2f each): not the "
+                  "calibration sequence (white x %zu, black, codes)",
+                  k, below_max[w], above_min[(w + k) % n], config_.max_phase_distance, k);
     why = text;
-    return std::nullopt;
   }
-  return w;
+  return candidates;
 }
 
 std::string ViewAssembler::check_cycle(std::size_t w) const {
   const std::size_t n = frames_.size();
   const decode::GrayImage8& white = run_[w];
-  const decode::GrayImage8& black = run_[w + 1];
+  const decode::GrayImage8& black = run_[w + kWhiteFrames];
   const decode::GrayImage8& white_again = run_[w + n];
   const std::size_t pixels = white.pixels.size();
   std::vector<std::size_t> lit;
@@ -198,7 +213,7 @@ std::string ViewAssembler::check_cycle(std::size_t w) const {
     return why;
   }
   const double lit_mean = lit_sum / static_cast<double>(lit.size());
-  for (std::size_t f = 2; f + 1 < n; f += 2) {
+  for (std::size_t f = kWhiteFrames + 1; f + 1 < n; f += 2) {
     const decode::GrayImage8& pos = run_[w + f];
     const decode::GrayImage8& neg = run_[w + f + 1];
     double mismatch = 0;
@@ -209,7 +224,7 @@ std::string ViewAssembler::check_cycle(std::size_t w) const {
     mismatch /= static_cast<double>(lit.size()) * lit_mean;
     if (mismatch > config_.max_pair_mismatch) {
       std::snprintf(why, sizeof why,
-                    "frames %zu and %zu after the white one are not the complementary pair %s "
+                    "frames %zu and %zu from the first white one are not the complementary pair %s "
                     "(mismatch %.2f of the lit level, at most %.2f): a frame slipped, or the "
                     "projector shows another sequence",
                     f, f + 1, frame_label(frames_[f]).c_str(), mismatch, config_.max_pair_mismatch);
@@ -224,6 +239,12 @@ std::string ViewAssembler::check_cycle(std::size_t w) const {
     return why;
   }
   return {};
+}
+
+std::vector<FrameId> projection_sequence(const CaptureCodes& codes) {
+  std::vector<FrameId> frames = capture_frames(codes);
+  frames.insert(frames.begin(), kWhiteFrames - 1, FrameId{FrameKind::kWhite});
+  return frames;
 }
 
 decode::GrayImage8 projector_pattern(const CaptureCodes& codes, const FrameId& frame) {

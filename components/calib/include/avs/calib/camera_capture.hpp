@@ -1,7 +1,7 @@
 // Adapter: the rig's camera and projector as a calibration capture source (issue 14 section 2,
 // `avs calib capture --source camera`). The projector (a DLPC350 through projector::ProjectorLink,
 // or none when the lab runs it by other means) loops the calibration sequence of
-// capture_frames() from its flash (`avs calib patterns` writes the images), one camera trigger
+// projection_sequence() from its flash (`avs calib patterns` writes the images), one camera trigger
 // per pattern; the camera (Aravis: GigE Vision or USB3 Vision) streams; ViewAssembler finds the
 // sequence in the frames. capture_view() is called once per board pose, while the board is
 // held still. Tested over the real GigE Vision stack against the simulator served by Aravis's
@@ -32,7 +32,7 @@ struct CameraCaptureConfig {
   std::chrono::milliseconds projector_start_timeout{5000};
 };
 
-/// The DLPC350 sequence of the calibration frames: capture_frames(codes) in order, one flash
+/// The DLPC350 sequence of the calibration frames: projection_sequence(codes) in order, one flash
 /// bit plane each from `first_flash_image` on (`avs calib patterns` packs them so), looped.
 projector::SequenceConfig calibration_sequence(const CaptureCodes& codes, int pattern_rate_hz,
                                                int first_flash_image);

@@ -1,20 +1,22 @@
 // Which calibration frame is this camera frame? (issue 14, `avs calib capture --source camera`)
 //
 // While a board pose is captured the projector loops the calibration sequence of
-// capture_frames() (white, black, column bits +/-, row bits +/-: N frames), one camera frame per
-// pattern, from any phase. A camera gives frame ids, not pattern numbers, so the assembler finds
-// the sequence in the images and never hands out a mislabelled view:
+// projection_sequence(): white three times, black, column bits +/-, row bits +/- (N frames), one
+// camera frame per pattern, from any phase. Why three whites: in any three consecutive code
+// frames two are a complementary pair, which cannot both light all of the scene, so no code
+// frames, whatever part of the projector's image the scene covers, look like the start of the
+// sequence (with a single white, a code bit constant over the scene, positive all lit and
+// negative all dark, does: measured in the simulator for the row code's MSB). A camera gives frame
+// ids, not pattern numbers, so the assembler finds the sequence in the images and never hands out a
+// mislabelled view:
 //
 //   * It keeps a run of frames with consecutive ids (a gap in the ids starts a new run: a frame
 //     lost in transport would shift every label after it).
-//   * Phase: over any N consecutive frames (each pattern once) the white frame is the
-//     per-pixel maximum and the black frame the minimum, up to noise. The phase is the frame
-//     that, with the frame after it, is closest to (maximum, minimum), by a margin over every
-//     other pair of neighbours (`min_phase_margin`). A code bit whose positive lights all of the
-//     scene the projector reaches in view and whose negative lights none (a scene inside one
-//     half of the projector's image) would look the same: then the phase cannot be told from
-//     the images, and nothing is labelled. The projector must light at least
-//     `min_lit_fraction` of the image by `lit_threshold_dn`.
+//   * Phase: over any N consecutive frames (each pattern once) the white frames are the
+//     per-pixel maximum and the black frame the minimum, up to noise. The phase is where three
+//     frames near the maximum are followed by one near the minimum (`max_phase_distance`).
+//     Should two phases fit and pass the checks below, nothing is labelled ("ambiguous"). The
+//     projector must light at least `min_lit_fraction` of the image by `lit_threshold_dn`.
 //   * Structure: in the cycle from that white frame, every bit's positive and negative must be
 //     complementary where the projector lights the scene: mean |pos + neg - white - black| over
 //     lit pixels at most `max_pair_mismatch` of the mean (white - black). A slip of one frame
@@ -23,7 +25,8 @@
 //     of the pixels differ by more than `moved_threshold_dn`): a board moved or shaken during
 //     the capture is refused, not averaged.
 //
-// The view is the first cycle's frames, as the camera gave them. Core: no I/O, no threads;
+// The view is the first cycle's frames, as the camera gave them, in capture_frames() order (the
+// first white frame stands for the three). Core: no I/O, no threads;
 // frames are copied into the assembler (a view is 36 frames, not a 500 Hz path).
 #pragma once
 
@@ -44,11 +47,9 @@ struct AssemblerConfig {
   int lit_threshold_dn = 8;           ///< white - black at least this: lit by the projector
   double min_lit_fraction = 0.02;     ///< of the image, lit in the white -> black step
   double max_pair_mismatch = 0.25;    ///< see the header comment
-  /// The white frame and the black one after it must be closer to the cycle's per-pixel
-  /// maximum and minimum (mean distance over lit pixels, as a fraction of the lit level
-  /// max - min) than any other two neighbours by this much, and each at most
-  /// max_phase_distance from it.
-  double min_phase_margin = 0.05;
+  /// The white frames and the black one after them are each at most this far from the
+  /// cycle's per-pixel maximum and minimum (mean distance over lit pixels, as a fraction of the lit
+  /// level max - min).
   double max_phase_distance = 0.15;
   int moved_threshold_dn = 24;
   double max_moved_fraction = 0.005;
@@ -78,8 +79,8 @@ class ViewAssembler {
 
  private:
   bool follows(std::uint64_t previous, std::uint64_t id) const;
-  /// The white frame's index in the run's first cycle, or nullopt and why.
-  std::optional<std::size_t> find_white(std::string& why) const;
+  /// Where the white frame may be in the run's first cycle, best first (none: `why`).
+  std::vector<std::size_t> white_candidates(std::string& why) const;
   /// Checks the run from white frame `w`; "" when it is a good view.
   std::string check_cycle(std::size_t w) const;
 
@@ -91,6 +92,13 @@ class ViewAssembler {
   std::optional<std::uint64_t> last_id_;
   std::int64_t pushed_ = 0;
 };
+
+/// White frames at the start of the projected sequence.
+inline constexpr std::size_t kWhiteFrames = 3;
+
+/// What the projector loops during a camera capture: kWhiteFrames white frames, then the rest
+/// of capture_frames() (black, column bits, row bits).
+std::vector<FrameId> projection_sequence(const CaptureCodes& codes);
 
 /// The projector image of one calibration frame (codes.projector_width x projector_height,
 /// 0 or 255): what the projector's flash holds for it (`avs calib patterns`) and what the
