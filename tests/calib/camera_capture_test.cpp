@@ -17,9 +17,16 @@
 
 #include "avs/calib/bench.hpp"
 #include "avs/calib/camera_capture.hpp"
+#include "avs/calib/capture_folder.hpp"
 #include "avs/calib/solve.hpp"
 #include "avs/projector/dlpc350_emulator.hpp"
 #include "sim_gige_camera.hpp"
+
+#ifdef AVS_PROGRAM
+#include <unistd.h>
+
+#include "avs/testing/child_process.hpp"
+#endif
 
 namespace avs::calib {
 namespace {
@@ -44,12 +51,32 @@ struct Rendered {
   std::vector<BoardView> views;
 };
 
+const Rendered& rendered() {
+  static const Rendered r;
+  return r;
+}
+
+/// The capture of the served camera (127.0.0.1, free-running at 200 Hz), no projector.
+CameraCaptureConfig loopback_config(std::chrono::milliseconds view_timeout) {
+  CameraCaptureConfig config;
+  config.camera.device_id = "127.0.0.1";
+  config.camera.trigger_mode = camera::TriggerMode::kFreeRun;
+  config.camera.frame_rate_hz = 200;
+  config.view_timeout = view_timeout;
+  return config;
+}
+
+/// Frame k of a projected cycle (projection_sequence) as an index into a view's frames: the
+/// white frames are all frame 0.
+std::vector<std::size_t> projected_frame_of(const BoardView& view) {
+  std::vector<std::size_t> frame_of(kWhiteFrames, 0);
+  for (std::size_t f = 1; f < view.frames.size(); ++f) frame_of.push_back(f);
+  return frame_of;
+}
+
 TEST(CalibCameraCapture, ViewsOverGigEVisionAreTheRenderedFramesAndSolve) {
-  const Rendered r;
-  // Frame k of a projected cycle as an index into a view's frames (the three whites are one).
-  std::vector<std::size_t> frame_of;
-  for (std::size_t k = 0; k < kWhiteFrames; ++k) frame_of.push_back(0);
-  for (std::size_t f = 1; f < r.views[0].frames.size(); ++f) frame_of.push_back(f);
+  const Rendered& r = rendered();
+  const std::vector<std::size_t> frame_of = projected_frame_of(r.views[0]);
   const std::size_t n = frame_of.size();
   std::atomic<int> showing{0};
   // The projector loops the sequence from frame 11 of a cycle when the camera starts.
@@ -66,10 +93,7 @@ TEST(CalibCameraCapture, ViewsOverGigEVisionAreTheRenderedFramesAndSolve) {
 
   auto emulator = std::make_shared<projector::Dlpc350Emulator>(
       projector::EmulatorConfig{.flash_image_count = 3, .busy_reads = 1});
-  CameraCaptureConfig config;
-  config.camera.device_id = "127.0.0.1";
-  config.camera.trigger_mode = camera::TriggerMode::kFreeRun;
-  config.camera.frame_rate_hz = 200;
+  CameraCaptureConfig config = loopback_config(std::chrono::milliseconds(10000));
   config.camera.width = r.info.camera_width;
   config.camera.height = r.info.camera_height;
   projector::LinkConfig link;
@@ -113,7 +137,7 @@ TEST(CalibCameraCapture, ViewsOverGigEVisionAreTheRenderedFramesAndSolve) {
 }
 
 TEST(CalibCameraCapture, NoSequenceOnTheCameraEndsTheViewWithTheReason) {
-  const Rendered r;
+  const Rendered& r = rendered();
   camera::SimGigECameraConfig served_config;
   served_config.frame_rate_hz = 200;
   // The projector is dark: the camera sees the black frame only.
@@ -122,11 +146,7 @@ TEST(CalibCameraCapture, NoSequenceOnTheCameraEndsTheViewWithTheReason) {
                                  const decode::GrayImage8& f = r.views[0].frames[1];
                                  std::memcpy(out, f.pixels.data(), f.pixels.size());
                                });
-  CameraCaptureConfig config;
-  config.camera.device_id = "127.0.0.1";
-  config.camera.trigger_mode = camera::TriggerMode::kFreeRun;
-  config.camera.frame_rate_hz = 200;
-  config.view_timeout = std::chrono::milliseconds(1500);
+  const CameraCaptureConfig config = loopback_config(std::chrono::milliseconds(1500));
   std::vector<std::string> log;
   CameraCapture capture(config, {}, r.info.codes,
                         [&](const std::string& line) { log.push_back(line); });
@@ -137,7 +157,7 @@ TEST(CalibCameraCapture, NoSequenceOnTheCameraEndsTheViewWithTheReason) {
 }
 
 TEST(CalibCameraCapture, AProjectorThatRefusesTheSequenceStopsTheCaptureWithItsWords) {
-  const Rendered r;
+  const Rendered& r = rendered();
   // Only one flash image: the calibration sequence's second image is not there.
   auto emulator = std::make_shared<projector::Dlpc350Emulator>(
       projector::EmulatorConfig{.flash_image_count = 1, .busy_reads = 1});
@@ -155,6 +175,99 @@ TEST(CalibCameraCapture, AProjectorThatRefusesTheSequenceStopsTheCaptureWithItsW
         << e.what();
   }
 }
+
+TEST(CalibCameraCapture, TheSamePoseTwiceIsNotTakenTwice) {
+  const Rendered& r = rendered();
+  const std::vector<std::size_t> frame_of = projected_frame_of(r.views[0]);
+  camera::SimGigECameraConfig served_config;
+  served_config.frame_rate_hz = 200;
+  camera::SimGigECamera served(served_config, r.info.camera_width, r.info.camera_height,
+                               [&](std::uint64_t k, std::uint8_t* out) {
+                                 const decode::GrayImage8& f =
+                                     r.views[0].frames[frame_of[k % frame_of.size()]];
+                                 std::memcpy(out, f.pixels.data(), f.pixels.size());
+                               });
+  const CameraCaptureConfig config = loopback_config(std::chrono::milliseconds(2000));
+  std::vector<std::string> log;
+  CameraCapture capture(config, {}, r.info.codes,
+                        [&](const std::string& line) { log.push_back(line); });
+  const std::optional<BoardView> first = capture.capture_view("first");
+  ASSERT_TRUE(first);
+  EXPECT_FALSE(capture.capture_view("second", &*first));
+  const bool waited = std::any_of(log.begin(), log.end(), [](const std::string& line) {
+    return line.find("second: the same pose as the last view") != std::string::npos;
+  });
+  EXPECT_TRUE(waited);
+}
+
+#ifdef AVS_PROGRAM
+/// `avs calib capture --source camera` as a lab runs it: the program captures while the test
+/// moves the (simulated) board to the next pose each time the program says it took one; then
+/// `avs calib solve` calibrates from the folder.
+TEST(CalibCameraCapture, TheCommandCapturesEachNewStillPoseAndTheFolderSolves) {
+  const Rendered& r = rendered();
+  const std::vector<std::size_t> frame_of = projected_frame_of(r.views[0]);
+  std::atomic<int> showing{0};
+  camera::SimGigECameraConfig served_config;
+  served_config.frame_rate_hz = 200;
+  camera::SimGigECamera served(
+      served_config, r.info.camera_width, r.info.camera_height,
+      [&](std::uint64_t k, std::uint8_t* out) {
+        const BoardView& view = r.views[static_cast<std::size_t>(showing.load())];
+        const decode::GrayImage8& f = view.frames[frame_of[(k + 5) % frame_of.size()]];
+        std::memcpy(out, f.pixels.data(), f.pixels.size());
+      });
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("avs_calib_camera_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  testing::ChildProcess child(
+      {AVS_PROGRAM, "calib", "capture", "--source", "camera", "--out", (dir / "capture").string(),
+       "--camera", "127.0.0.1", "--trigger", "free_run", "--rate", "200", "--projector", "emulator",
+       "--views", std::to_string(kViews), "--pose-timeout", "30"},
+      {}, dir / "capture.log");
+  ASSERT_TRUE(child.started());
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(180);
+  int taken = 0;
+  while (taken < kViews && std::chrono::steady_clock::now() < deadline) {
+    const std::string out = child.output();
+    const std::string line = "pose " + std::to_string(taken + 1) + "/" + std::to_string(kViews) +
+                             " pose_00" + std::to_string(taken) + " captured";
+    if (out.find(line) != std::string::npos) {
+      ++taken;
+      if (taken < kViews) showing = taken;  // the board moves on
+    } else if (child.wait(std::chrono::milliseconds(50)) != -1) {
+      break;  // ended early
+    }
+  }
+  EXPECT_EQ(taken, kViews) << child.output();
+  EXPECT_EQ(child.exit_code(), 0) << child.output();
+  const std::string out = child.output();
+  EXPECT_NE(out.find("DLPC350 emulator"), std::string::npos) << out;
+  EXPECT_NE(out.find("board found in " + std::to_string(kViews)), std::string::npos) << out;
+
+  // The folder holds exactly the rendered frames.
+  const CaptureIndex index = read_capture_index(dir / "capture");
+  EXPECT_EQ(index.info.source, "camera");
+  ASSERT_EQ(static_cast<int>(index.views.size()), kViews);
+  for (int v = 0; v < kViews; ++v) {
+    const BoardView got =
+        read_view(dir / "capture", index.views[static_cast<std::size_t>(v)], index.info);
+    ASSERT_EQ(got.frames.size(), r.views[static_cast<std::size_t>(v)].frames.size());
+    for (std::size_t f = 0; f < got.frames.size(); ++f) {
+      EXPECT_EQ(got.frames[f].pixels, r.views[static_cast<std::size_t>(v)].frames[f].pixels)
+          << "view " << v << " frame " << f;
+    }
+  }
+  const int solved =
+      testing::run_program({AVS_PROGRAM, "calib", "solve", (dir / "capture").string(), "--out",
+                            (dir / "calibration.yaml").string()},
+                           {}, dir / "solve.log");
+  EXPECT_EQ(solved, 0) << testing::read_file(dir / "solve.log");
+  EXPECT_TRUE(std::filesystem::exists(dir / "calibration.yaml"));
+  std::filesystem::remove_all(dir);
+}
+#endif  // AVS_PROGRAM
 
 }  // namespace
 }  // namespace avs::calib

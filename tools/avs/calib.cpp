@@ -10,12 +10,16 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "flash_images.hpp"
 
 #if __has_include("avs/calib/capture_folder.hpp")
 #include "avs/calib/bench.hpp"
+#include "avs/calib/camera_capture.hpp"
 #include "avs/calib/capture_folder.hpp"
 #include "avs/calib/solve.hpp"
 #include "avs/decode/calibration_yaml.hpp"
+#include "avs/projector/dlpc350_emulator.hpp"
+#include "avs/projector/hidapi_transport.hpp"
 #define AVS_HAVE_CALIB 1
 #endif
 
@@ -34,6 +38,30 @@ struct CaptureOptions {
   std::string calibration;
   double noise_dn = 2.0;
   int pixels_per_code = 4;
+  // --source camera
+  int views = 12;
+  std::string camera;
+  std::string trigger = "hardware";
+  int rate_hz = 1000;
+  double exposure_us = 0;
+  double gain = -1;
+  int width = 512;
+  int height = 512;
+  std::string projector = "hid";
+  std::string projector_serial;
+  int first_flash_image = 1;
+  double pose_timeout_s = 60;
+  int squares_x = 10;
+  int squares_y = 7;
+  double square_mm = 30;
+  double margin_mm = 30;
+};
+
+struct CalibPatternsOptions {
+  std::string out;
+  std::string calibration;
+  int pixels_per_code = 4;
+  int first_flash_image = 1;
 };
 
 struct SolveOptions {
@@ -57,10 +85,65 @@ struct BenchOptions {
 
 namespace fs = std::filesystem;
 
+/// What `avs calib capture` tells about the views as they come, and its verdict at the end:
+/// whether the board was found, and how much of the camera image the corners reach (the checks
+/// `avs calib solve` makes).
+class CaptureTally {
+ public:
+  explicit CaptureTally(const calib::CaptureInfo& info) : info_(info) {}
+
+  /// "board found, N corners" or "board NOT found in the white frame".
+  std::string add(const calib::BoardView& view) {
+    const std::vector<Eigen::Vector2d> c = calib::find_board_corners(view.frames[0], info_.board);
+    ++views_;
+    found_ += c.empty() ? 0 : 1;
+    for (const Eigen::Vector2d& p : c) {
+      const int i = std::clamp(static_cast<int>(p.x() * 4 / info_.camera_width), 0, 3);
+      const int j = std::clamp(static_cast<int>(p.y() * 4 / info_.camera_height), 0, 3);
+      reached_[j][i] = true;
+    }
+    return c.empty() ? "board NOT found in the white frame"
+                     : "board found, " + std::to_string(c.size()) + " corners";
+  }
+
+  /// Prints the verdict; 0, or 3 when the capture is too little for a calibration.
+  int finish(const fs::path& dir) const {
+    int cells = 0;
+    for (const auto& row : reached_) cells += static_cast<int>(std::count(row, row + 4, true));
+    std::printf("captured %d poses to %s: board found in %d, camera coverage %d of 16 grid cells\n",
+                views_, dir.string().c_str(), found_, cells);
+    const calib::SolveConfig defaults;
+    if (found_ < defaults.min_views || cells < defaults.min_coverage * 16) {
+      std::printf(
+          "WARNING: too little for a calibration (solve needs %d views with the board and "
+          "%.0f %% coverage): add poses%s\n",
+          defaults.min_views, 100 * defaults.min_coverage,
+          cells < defaults.min_coverage * 16 ? " nearer the image corners" : "");
+      return 3;
+    }
+    return 0;
+  }
+
+ private:
+  const calib::CaptureInfo& info_;
+  int views_ = 0;
+  int found_ = 0;
+  bool reached_[4][4] = {};
+};
+
+std::string pose_name(std::size_t v) {
+  char name[32];
+  std::snprintf(name, sizeof name, "pose_%03zu", v);
+  return name;
+}
+
+int run_camera_capture(const CaptureOptions& o);
+
 int run_capture(const CaptureOptions& o) {
+  if (o.source == "camera") return run_camera_capture(o);
   if (o.source != "sim") {
     std::cerr << "avs calib capture: source '" << o.source
-              << "' is NOT IMPLEMENTED yet (issue 14: bag and camera sources); only 'sim'\n";
+              << "' is NOT IMPLEMENTED (issue 14: a bag source); 'sim' or 'camera'\n";
     return 2;
   }
   if (o.poses.empty() == (o.generate == 0)) {
@@ -82,50 +165,152 @@ int run_capture(const CaptureOptions& o) {
   calib::SimCapture capture(renderer, poses.board, o.pixels_per_code);
   calib::CaptureIndex index{capture.info(), {}};
   const fs::path dir(o.out);
-  std::vector<Eigen::Vector2d> corners;
-  int found = 0;
+  CaptureTally tally(capture.info());
   const std::size_t n = poses.T_camera_board.size();
   for (std::size_t v = 0; v < n; ++v) {
-    char name[32];
-    std::snprintf(name, sizeof name, "pose_%03zu", v);
     const Eigen::Isometry3d& T = poses.T_camera_board[v];
     const calib::PoseVisibility seen =
         calib::pose_visibility(renderer.geometry, poses.board, T, 0.0);
-    const calib::BoardView view = capture.render(T, static_cast<int>(v), name);
+    const calib::BoardView view = capture.render(T, static_cast<int>(v), pose_name(v));
     calib::write_view_frames(dir, view, capture.info());
     index.views.push_back({view.name, view.T_camera_board_truth});
     calib::write_capture_index(dir, index);
-    const std::vector<Eigen::Vector2d> c = calib::find_board_corners(view.frames[0], poses.board);
-    found += c.empty() ? 0 : 1;
-    corners.insert(corners.end(), c.begin(), c.end());
     std::printf(
-        "pose %zu/%zu %s: z %.2f m, corners in view %.0f %% camera / %.0f %% projector, "
-        "%s\n",
-        v + 1, n, name, T.translation().z(), 100 * seen.camera, 100 * seen.projector,
-        c.empty() ? "board NOT found in the white frame"
-                  : ("board found, " + std::to_string(c.size()) + " corners").c_str());
+        "pose %zu/%zu %s: z %.2f m, corners in view %.0f %% camera / %.0f %% projector, %s\n",
+        v + 1, n, view.name.c_str(), T.translation().z(), 100 * seen.camera, 100 * seen.projector,
+        tally.add(view).c_str());
     std::fflush(stdout);
   }
-  // Coverage of the camera image by the corners found (the check `avs calib solve` makes).
-  bool reached[4][4] = {};
-  for (const Eigen::Vector2d& p : corners) {
-    const int i = std::clamp(static_cast<int>(p.x() * 4 / capture.info().camera_width), 0, 3);
-    const int j = std::clamp(static_cast<int>(p.y() * 4 / capture.info().camera_height), 0, 3);
-    reached[j][i] = true;
+  return tally.finish(dir);
+}
+
+/// The capture's codes and the rig's depth layout from the rig's nominal calibration.
+calib::CaptureInfo camera_capture_info(const CaptureOptions& o) {
+  const decode::SensorGeometry nominal = o.calibration.empty()
+                                             ? decode::default_sensor_geometry()
+                                             : decode::load_sensor_geometry_yaml(o.calibration);
+  calib::CaptureInfo info;
+  info.source = "camera";
+  info.board.squares_x = o.squares_x;
+  info.board.squares_y = o.squares_y;
+  info.board.square_m = o.square_mm / 1000;
+  info.board.margin_m = o.margin_mm / 1000;
+  if (const std::string why = info.board.problem(); !why.empty()) {
+    throw std::runtime_error("board: " + why);
   }
-  int cells = 0;
-  for (const auto& row : reached) cells += static_cast<int>(std::count(row, row + 4, true));
-  std::printf("captured %zu poses to %s: board found in %d, camera coverage %d of 16 grid cells\n",
-              n, dir.string().c_str(), found, cells);
-  const calib::SolveConfig defaults;
-  if (found < defaults.min_views || cells < defaults.min_coverage * 16) {
+  info.camera_width = o.width;
+  info.camera_height = o.height;
+  info.codes = calib::calibration_codes(nominal.projector.width, nominal.projector.height,
+                                        o.pixels_per_code);
+  info.depth_code_layout = nominal.layout;
+  return info;
+}
+
+int run_camera_capture(const CaptureOptions& o) {
+  const calib::CaptureInfo info = camera_capture_info(o);
+  calib::CameraCaptureConfig config;
+  config.camera.device_id = o.camera;
+  config.camera.width = o.width;
+  config.camera.height = o.height;
+  config.camera.exposure_time_us = o.exposure_us;
+  config.camera.gain = o.gain;
+  config.camera.frame_rate_hz = o.rate_hz;
+  config.camera.trigger_mode =
+      o.trigger == "free_run" ? camera::TriggerMode::kFreeRun : camera::TriggerMode::kHardware;
+  config.view_timeout = std::chrono::milliseconds(static_cast<long>(o.pose_timeout_s * 1000));
+  projector::TransportOpener opener;
+  if (o.projector != "none") {
+    projector::LinkConfig link;
+    link.sequence = calib::calibration_sequence(info.codes, o.rate_hz, o.first_flash_image);
+    config.projector = link;
+    if (o.projector == "emulator") {
+      // No hardware: avs's DLPC350 emulator with the flash the sequence needs (for a dry run
+      // against a simulated camera; nothing is projected).
+      const int images =
+          o.first_flash_image + (link.sequence.pattern_count + projector::kPatternsPerImage - 1) /
+                                    projector::kPatternsPerImage;
+      opener = projector::emulator_opener(std::make_shared<projector::Dlpc350Emulator>(
+          projector::EmulatorConfig{.flash_image_count = images, .busy_reads = 1}));
+    } else {
+      opener = projector::hidapi_opener(
+          {projector::kUsbVendorId, projector::kUsbProductId, o.projector_serial});
+    }
+  }
+  std::printf(
+      "calibration capture from the camera: %zu frames per pose (white x %zu, black, %d column "
+      "and %d row bits +/-) at %d Hz; projector %s\n",
+      calib::projection_sequence(info.codes).size(), calib::kWhiteFrames,
+      info.codes.columns.bit_count, info.codes.rows.bit_count, o.rate_hz, o.projector.c_str());
+  calib::CameraCapture capture(config, opener, info.codes, [](const std::string& line) {
+    std::printf("  %s\n", line.c_str());
+    std::fflush(stdout);
+  });
+  std::printf("%s\n", capture.description().c_str());
+  const fs::path dir(o.out);
+  calib::CaptureIndex index{info, {}};
+  CaptureTally tally(index.info);
+  std::optional<calib::BoardView> previous;
+  for (int v = 0; v < o.views; ++v) {
     std::printf(
-        "WARNING: too little for a calibration (solve needs %d views with the board and "
-        "%.0f %% coverage): add poses%s\n",
-        defaults.min_views, 100 * defaults.min_coverage,
-        cells < defaults.min_coverage * 16 ? " nearer the image corners" : "");
-    return 3;
+        "pose %d/%d: put the board in a new pose and hold it still (taken when the view is "
+        "new and still; %.0f s)\n",
+        v + 1, o.views, o.pose_timeout_s);
+    std::fflush(stdout);
+    std::optional<calib::BoardView> view = capture.capture_view(
+        pose_name(static_cast<std::size_t>(v)), previous ? &*previous : nullptr);
+    if (!view) {
+      std::printf("pose %d/%d: no new still view within %.0f s: capture ends with %d poses\n",
+                  v + 1, o.views, o.pose_timeout_s, v);
+      break;
+    }
+    calib::write_view_frames(dir, *view, index.info);
+    index.views.push_back({view->name, std::nullopt});
+    calib::write_capture_index(dir, index);
+    std::printf("pose %d/%d %s captured: %s\n", v + 1, o.views, view->name.c_str(),
+                tally.add(*view).c_str());
+    std::fflush(stdout);
+    previous = std::move(view);
   }
+  return tally.finish(dir);
+}
+
+int run_calib_patterns(const CalibPatternsOptions& o) {
+  const decode::SensorGeometry nominal = o.calibration.empty()
+                                             ? decode::default_sensor_geometry()
+                                             : decode::load_sensor_geometry_yaml(o.calibration);
+  const calib::CaptureCodes codes = calib::calibration_codes(
+      nominal.projector.width, nominal.projector.height, o.pixels_per_code);
+  const fs::path dir(o.out);
+  fs::create_directories(dir);
+  std::vector<std::vector<std::uint8_t>> pixels;
+  std::vector<std::string> labels;
+  std::ofstream index(dir / "index.csv");
+  index << "index,file,frame,width,height\n";
+  const std::vector<calib::FrameId> sequence = calib::projection_sequence(codes);
+  for (std::size_t k = 0; k < sequence.size(); ++k) {
+    const decode::GrayImage8 image = calib::projector_pattern(codes, sequence[k]);
+    const std::string frame = sequence[k].file_name().substr(0, sequence[k].file_name().size() - 4);
+    char name[64];
+    std::snprintf(name, sizeof name, "calib_%02zu_%s.png", k, frame.c_str());
+    decode::write_png_gray8((dir / name).string(), image);
+    index << k << ',' << name << ',' << frame << ',' << image.width << ',' << image.height << '\n';
+    pixels.push_back(image.pixels);
+    labels.push_back(frame);
+  }
+  index.close();
+  const int images = write_flash_images(pixels, labels, "frame", codes.projector_width,
+                                        codes.projector_height, o.first_flash_image, dir);
+  if (!index || images < 0) {
+    std::cerr << "avs calib patterns: cannot write to " << dir.string() << '\n';
+    return 1;
+  }
+  std::printf(
+      "wrote the calibration sequence: %zu patterns (%dx%d; white x %zu, black, %d column and %d "
+      "row Gray-code bits +/-, %d DMD pixels per code) as PNG files with index.csv, and %d "
+      "LightCrafter 4500 flash image(s) with lut.csv, first flash image index %d, to %s\n",
+      sequence.size(), codes.projector_width, codes.projector_height, calib::kWhiteFrames,
+      codes.columns.bit_count, codes.rows.bit_count, o.pixels_per_code, images, o.first_flash_image,
+      dir.string().c_str());
   return 0;
 }
 
@@ -266,6 +451,9 @@ int run_solve(const SolveOptions&) {
 int run_bench(const BenchOptions&) {
   return 1;
 }
+int run_calib_patterns(const CalibPatternsOptions&) {
+  return 1;
+}
 
 #endif
 
@@ -278,10 +466,15 @@ void add_calib_command(Command& app) {
   auto* capture = calib->add_subcommand(
       "capture",
       "Capture board views (white, black, column and row Gray codes, positive and negative) "
-      "into a capture folder (PNG per frame + index.yaml); source: the simulator");
+      "into a capture folder (PNG per frame + index.yaml); sources: the simulator, or the rig's "
+      "camera and projector");
   capture->add_option("--out", c.out, "capture folder (created)")->required();
-  capture->add_option("--source", c.source, "sim (bag and camera: not implemented yet)")
-      ->capture_default_str();
+  capture
+      ->add_option("--source", c.source,
+                   "sim (the simulator) or camera (the rig: a GenICam camera through Aravis, "
+                   "the projector looping the calibration sequence); bag: not implemented")
+      ->capture_default_str()
+      ->check_member({"sim", "camera", "bag"});
   capture->add_option("--poses", c.poses, "board-pose YAML (board and a list of poses)")
       ->check_existing_file();
   capture->add_option("--generate", c.generate, "or: a seeded spread of N board poses")
@@ -300,8 +493,9 @@ void add_calib_command(Command& app) {
       ->check_range(0, 4294967295.0);
   capture
       ->add_option("--calibration", c.calibration,
-                   "the simulated rig's true calibration (default: the bench's sensor, "
-                   "distortion on both lenses)")
+                   "sim: the simulated rig's true calibration (default: the bench's sensor, "
+                   "distortion on both lenses); camera: the rig's nominal calibration "
+                   "(projector size and depth code layout; default: the paper's)")
       ->check_existing_file();
   capture->add_option("--noise", c.noise_dn, "sensor noise sigma, DN")
       ->capture_default_str()
@@ -309,7 +503,85 @@ void add_calib_command(Command& app) {
   capture->add_option("--pixels-per-code", c.pixels_per_code, "DMD pixels per code stripe")
       ->capture_default_str()
       ->check_range(1, 64);
+  capture->add_option("--views", c.views, "camera: board poses to capture")
+      ->capture_default_str()
+      ->check_range(1, 1000);
+  capture->add_option("--camera", c.camera,
+                      "camera: Aravis id, serial or IP (empty: the only one)");
+  capture
+      ->add_option("--trigger", c.trigger,
+                   "camera: hardware (the projector's trigger out) or free_run")
+      ->capture_default_str()
+      ->check_member({"hardware", "free_run"});
+  capture->add_option("--rate", c.rate_hz, "camera and projector: patterns per second")
+      ->capture_default_str()
+      ->check_range(1, 4000);
+  capture->add_option("--exposure-us", c.exposure_us, "camera: ExposureTime (0: leave it)")
+      ->capture_default_str()
+      ->check_range(0, 1e7);
+  capture->add_option("--gain", c.gain, "camera: Gain (-1: leave it)")
+      ->capture_default_str()
+      ->check_range(-1, 1000);
+  capture->add_option("--width", c.width, "camera: ROI width, px")
+      ->capture_default_str()
+      ->check_range(16, 16384);
+  capture->add_option("--height", c.height, "camera: ROI height, px")
+      ->capture_default_str()
+      ->check_range(16, 16384);
+  capture
+      ->add_option("--projector", c.projector,
+                   "camera: hid (the LightCrafter 4500 over USB), emulator (avs's DLPC350 "
+                   "emulator: a dry run, nothing projected) or none (it already loops the "
+                   "calibration sequence)")
+      ->capture_default_str()
+      ->check_member({"hid", "emulator", "none"});
+  capture->add_option("--projector-serial", c.projector_serial,
+                      "camera: USB serial (empty: the first)");
+  capture
+      ->add_option("--first-flash-image", c.first_flash_image,
+                   "camera: flash index of the calibration sequence's first image "
+                   "(avs calib patterns)")
+      ->capture_default_str()
+      ->check_range(0, 255);
+  capture
+      ->add_option("--pose-timeout", c.pose_timeout_s,
+                   "camera: seconds to wait for each new still pose")
+      ->capture_default_str()
+      ->check_range(0.1, 3600);
+  capture->add_option("--squares-x", c.squares_x, "camera: board squares along x")
+      ->capture_default_str()
+      ->check_range(3, 100);
+  capture->add_option("--squares-y", c.squares_y, "camera: board squares along y")
+      ->capture_default_str()
+      ->check_range(3, 100);
+  capture->add_option("--square-mm", c.square_mm, "camera: board square size, mm")
+      ->capture_default_str()
+      ->check_range(1, 1000);
+  capture->add_option("--margin-mm", c.margin_mm, "camera: light border around the squares, mm")
+      ->capture_default_str()
+      ->check_range(0, 1000);
   capture->callback([] { guarded("capture", [] { return run_capture(c); }); });
+
+  static CalibPatternsOptions p;
+  auto* patterns = calib->add_subcommand(
+      "patterns",
+      "Write the calibration sequence the projector loops during `capture --source camera` "
+      "(white x 3, black, column and row Gray codes +/-) as PNG files with index.csv, and the "
+      "LightCrafter 4500's flash images with lut.csv");
+  patterns->add_option("--out", p.out, "output folder (created)")->required();
+  patterns
+      ->add_option("--calibration", p.calibration,
+                   "the rig's nominal calibration (projector size; default: the paper's)")
+      ->check_existing_file();
+  patterns->add_option("--pixels-per-code", p.pixels_per_code, "DMD pixels per code stripe")
+      ->capture_default_str()
+      ->check_range(1, 64);
+  patterns
+      ->add_option("--first-flash-image", p.first_flash_image,
+                   "flash index of the first image (0 holds the depth sequence of avs patterns)")
+      ->capture_default_str()
+      ->check_range(0, 255);
+  patterns->callback([] { guarded("patterns", [] { return run_calib_patterns(p); }); });
 
   static SolveOptions s;
   auto* solve = calib->add_subcommand(

@@ -10,6 +10,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "flash_images.hpp"
 
 #if __has_include("avs/decode/png_io.hpp")
 #include "avs/decode/calibration_yaml.hpp"
@@ -37,48 +38,6 @@ struct PatternsOptions {
   int height = 1140;
   int first_flash_image = 0;
 };
-
-#if defined(AVS_HAVE_DECODE) && defined(AVS_HAVE_PROJECTOR)
-/// The LightCrafter 4500's flash images and the pattern LUT the `projector` component sends
-/// for them (the one LUT: projector::pattern_lut).
-bool write_flash_images(const std::vector<decode::PatternImage>& patterns, int width, int height,
-                        int first_flash_image, const std::filesystem::path& dir) {
-  std::vector<std::vector<std::uint8_t>> pixels;
-  for (const decode::PatternImage& p : patterns) pixels.push_back(p.pixels);
-  const auto images = projector::pack_flash_images(pixels, width, height);
-  for (std::size_t i = 0; i < images.size(); ++i) {
-    char name[64];
-    std::snprintf(name, sizeof name, "flash_image_%02zu.bmp", i);
-    const std::vector<std::uint8_t> bmp = projector::encode_bmp24(images[i]);
-    std::ofstream out(dir / name, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bmp.data()), static_cast<std::streamsize>(bmp.size()));
-    if (!out) return false;
-  }
-  projector::SequenceConfig sequence;
-  sequence.pattern_count = static_cast<int>(patterns.size());
-  sequence.first_flash_image = first_flash_image;
-  std::ofstream lut(dir / "lut.csv");
-  lut << "entry,bit_index,polarity,flash_file,flash_image_index,pattern_number,bit_plane,"
-         "bit_depth,trigger,buffer_swap,trigger_out_previous,lut_bytes\n";
-  const auto entries = projector::pattern_lut(sequence);
-  for (std::size_t k = 0; k < entries.size(); ++k) {
-    const projector::PatternEntry& e = entries[k];
-    const projector::FlashSlot slot = projector::flash_slot(static_cast<int>(k));
-    const auto b = e.encode();
-    char bytes[16];
-    std::snprintf(bytes, sizeof bytes, "%02X %02X %02X", b[0], b[1], b[2]);
-    lut << k << ',' << patterns[k].bit_index << ','
-        << (patterns[k].polarity == decode::Polarity::kPositive ? "positive" : "negative") << ','
-        << "flash_image_" << (slot.image < 10 ? "0" : "") << slot.image << ".bmp,"
-        << first_flash_image + slot.image << ',' << e.pattern_number << ','
-        << projector::plane_name(e.pattern_number) << ',' << e.bit_depth << ','
-        << (e.trigger == projector::TriggerType::kInternal ? "internal" : "external") << ','
-        << (e.buffer_swap ? 1 : 0) << ',' << (e.trigger_out_previous ? 1 : 0) << ',' << bytes
-        << '\n';
-  }
-  return static_cast<bool>(lut);
-}
-#endif
 
 #ifdef AVS_HAVE_DECODE
 int write_patterns(const PatternsOptions& o, Command& cmd) {
@@ -147,7 +106,15 @@ int write_patterns(const PatternsOptions& o, Command& cmd) {
             << " rows from row " << layout.first_row << ") and index.csv to " << dir.string()
             << '\n';
 #ifdef AVS_HAVE_PROJECTOR
-  if (!write_flash_images(patterns, width, height, o.first_flash_image, dir)) {
+  std::vector<std::vector<std::uint8_t>> pixels;
+  std::vector<std::string> labels;
+  for (const decode::PatternImage& p : patterns) {
+    pixels.push_back(p.pixels);
+    labels.push_back(std::to_string(p.bit_index) +
+                     (p.polarity == decode::Polarity::kPositive ? ",positive" : ",negative"));
+  }
+  if (write_flash_images(pixels, labels, "bit_index,polarity", width, height, o.first_flash_image,
+                         dir) < 0) {
     std::cerr << "avs patterns: cannot write the flash images or lut.csv to " << dir.string()
               << '\n';
     return 1;

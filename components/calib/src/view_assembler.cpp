@@ -194,15 +194,12 @@ std::string ViewAssembler::check_cycle(std::size_t w) const {
   const std::size_t pixels = white.pixels.size();
   std::vector<std::size_t> lit;
   double lit_sum = 0;
-  std::size_t moved = 0;
   for (std::size_t i = 0; i < pixels; ++i) {
     const int d = int{white.pixels[i]} - int{black.pixels[i]};
     if (d >= config_.lit_threshold_dn) {
       lit.push_back(i);
       lit_sum += d;
     }
-    if (std::abs(int{white.pixels[i]} - int{white_again.pixels[i]}) > config_.moved_threshold_dn)
-      ++moved;
   }
   char why[256];
   if (lit.size() < config_.min_lit_fraction * static_cast<double>(pixels)) {
@@ -231,14 +228,25 @@ std::string ViewAssembler::check_cycle(std::size_t w) const {
       return why;
     }
   }
-  if (moved > config_.max_moved_fraction * static_cast<double>(pixels)) {
+  if (const double moved = changed_fraction(white, white_again, config_.moved_threshold_dn);
+      moved > config_.max_moved_fraction) {
     std::snprintf(why, sizeof why,
                   "the scene changed during the capture (%.1f %% of the pixels of the white "
                   "frames one cycle apart differ by more than %d DN): hold the board still",
-                  100.0 * moved / pixels, config_.moved_threshold_dn);
+                  100.0 * moved, config_.moved_threshold_dn);
     return why;
   }
   return {};
+}
+
+double changed_fraction(const decode::GrayImage8& a, const decode::GrayImage8& b,
+                        int threshold_dn) {
+  if (a.pixels.size() != b.pixels.size()) return 1.0;
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    changed += std::abs(int{a.pixels[i]} - int{b.pixels[i]}) > threshold_dn ? 1 : 0;
+  }
+  return a.pixels.empty() ? 0.0 : static_cast<double>(changed) / a.pixels.size();
 }
 
 std::vector<FrameId> projection_sequence(const CaptureCodes& codes) {

@@ -29,6 +29,9 @@ struct CameraCaptureConfig {
   AssemblerConfig assembler;
   std::chrono::milliseconds settle{300};  ///< frames dropped after the board was placed
   std::chrono::milliseconds view_timeout{10000};
+  /// A new pose changes at least this fraction of the white frame's pixels (by more than
+  /// assembler.moved_threshold_dn).
+  double min_new_pose_fraction = 0.02;
   std::chrono::milliseconds projector_start_timeout{5000};
 };
 
@@ -51,8 +54,12 @@ class CameraCapture {
   CameraCapture& operator=(const CameraCapture&) = delete;
 
   /// The frames of one board pose: drops `settle` worth of frames, then assembles a checked
-  /// cycle. Returns nullopt after `view_timeout` (every rejection was logged).
-  std::optional<BoardView> capture_view(const std::string& name);
+  /// cycle. With `previous` (the last view taken), a view whose white frame differs from
+  /// previous's in less than `min_new_pose_fraction` of the pixels is the same pose: skipped,
+  /// and the capture waits for the board to move. Returns nullopt after `view_timeout`
+  /// (every rejection was logged, once per reason in a row).
+  std::optional<BoardView> capture_view(const std::string& name,
+                                        const BoardView* previous = nullptr);
 
   int width() const { return config_.camera.width; }
   int height() const { return config_.camera.height; }

@@ -93,6 +93,10 @@ class ViewAssembler {
   std::int64_t pushed_ = 0;
 };
 
+/// The fraction of pixels of `a` and `b` that differ by more than `threshold_dn` (1 when their
+/// sizes differ).
+double changed_fraction(const decode::GrayImage8& a, const decode::GrayImage8& b, int threshold_dn);
+
 /// White frames at the start of the projected sequence.
 inline constexpr std::size_t kWhiteFrames = 3;
 
