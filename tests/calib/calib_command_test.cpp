@@ -64,14 +64,14 @@ TEST(CalibCommand, CaptureThenSolveWritesALoadableCalibration) {
   fs::remove_all(dir);
 }
 
-TEST(CalibCommand, UnimplementedSourcesSaySo) {
+TEST(CalibCommand, AnUnknownSourceIsRefusedListingTheSources) {
   const fs::path out = fs::temp_directory_path() / ("avs-calib-src-" + std::to_string(getpid()));
-  EXPECT_EQ(avs::testing::run_avs(
-                {"calib", "capture", "--source", "bag", "--generate", "3", "--out", out.string()},
-                out.string() + ".log", out.string() + ".err"),
-            2);
-  EXPECT_NE(avs::testing::read_file(out.string() + ".err").find("NOT IMPLEMENTED"),
+  EXPECT_NE(avs::testing::run_avs({"calib", "capture", "--source", "tape", "--out", out.string()},
+                                  out.string() + ".log", out.string() + ".err"),
+            0);
+  EXPECT_NE(avs::testing::read_file(out.string() + ".err").find("{sim,camera,bag}"),
             std::string::npos);
+  EXPECT_FALSE(fs::exists(out));
   fs::remove(out.string() + ".log");
   fs::remove(out.string() + ".err");
 }

@@ -15,11 +15,11 @@
 
 #include <gtest/gtest.h>
 
-#include "avs/calib/bench.hpp"
 #include "avs/calib/camera_capture.hpp"
 #include "avs/calib/capture_folder.hpp"
 #include "avs/calib/solve.hpp"
 #include "avs/projector/dlpc350_emulator.hpp"
+#include "rendered_views.hpp"
 #include "sim_gige_camera.hpp"
 
 #ifdef AVS_PROGRAM
@@ -31,30 +31,10 @@
 namespace avs::calib {
 namespace {
 
-constexpr int kViews = 8;
-
-struct Rendered {
-  Rendered() {
-    sim::RendererConfig renderer;
-    renderer.geometry = bench_truth_geometry();
-    renderer.noise_sigma_dn = 2.0;
-    SimCapture capture(renderer, board);
-    info = capture.info();
-    const auto poses = generate_board_poses(renderer.geometry, board, kViews, 0.55, 1.6, 30, 7);
-    for (int v = 0; v < kViews; ++v) {
-      views.push_back(
-          capture.render(poses[static_cast<std::size_t>(v)], v, "pose_" + std::to_string(v)));
-    }
-  }
-  sim::Checkerboard board;
-  CaptureInfo info;
-  std::vector<BoardView> views;
-};
-
-const Rendered& rendered() {
-  static const Rendered r;
-  return r;
-}
+using test::kViews;
+using test::projected_frame_of;
+using test::Rendered;
+using test::rendered;
 
 /// The capture of the served camera (127.0.0.1, free-running at 200 Hz), no projector.
 CameraCaptureConfig loopback_config(std::chrono::milliseconds view_timeout) {
@@ -64,14 +44,6 @@ CameraCaptureConfig loopback_config(std::chrono::milliseconds view_timeout) {
   config.camera.frame_rate_hz = 200;
   config.view_timeout = view_timeout;
   return config;
-}
-
-/// Frame k of a projected cycle (projection_sequence) as an index into a view's frames: the
-/// white frames are all frame 0.
-std::vector<std::size_t> projected_frame_of(const BoardView& view) {
-  std::vector<std::size_t> frame_of(kWhiteFrames, 0);
-  for (std::size_t f = 1; f < view.frames.size(); ++f) frame_of.push_back(f);
-  return frame_of;
 }
 
 TEST(CalibCameraCapture, ViewsOverGigEVisionAreTheRenderedFramesAndSolve) {
@@ -193,9 +165,9 @@ TEST(CalibCameraCapture, TheSamePoseTwiceIsNotTakenTwice) {
                         [&](const std::string& line) { log.push_back(line); });
   const std::optional<BoardView> first = capture.capture_view("first");
   ASSERT_TRUE(first);
-  EXPECT_FALSE(capture.capture_view("second", &*first));
+  EXPECT_FALSE(capture.capture_view("second", {first->frames[0]}));
   const bool waited = std::any_of(log.begin(), log.end(), [](const std::string& line) {
-    return line.find("second: the same pose as the last view") != std::string::npos;
+    return line.find("second: a pose taken already") != std::string::npos;
   });
   EXPECT_TRUE(waited);
 }

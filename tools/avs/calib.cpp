@@ -10,9 +10,11 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "dds_environment.hpp"
 #include "flash_images.hpp"
 
 #if __has_include("avs/calib/capture_folder.hpp")
+#include "avs/calib/bag_capture.hpp"
 #include "avs/calib/bench.hpp"
 #include "avs/calib/camera_capture.hpp"
 #include "avs/calib/capture_folder.hpp"
@@ -42,7 +44,7 @@ struct CaptureOptions {
   int views = 12;
   std::string camera;
   std::string trigger = "hardware";
-  int rate_hz = 1000;
+  int rate_hz = 0;  ///< 0: camera 1000, bag: from the recording
   double exposure_us = 0;
   double gain = -1;
   int width = 512;
@@ -55,6 +57,10 @@ struct CaptureOptions {
   int squares_y = 7;
   double square_mm = 30;
   double margin_mm = 30;
+  // --source bag
+  std::string bag;
+  std::string topic = "/camera/image_raw";
+  int domain = 0;
 };
 
 struct CalibPatternsOptions {
@@ -138,14 +144,11 @@ std::string pose_name(std::size_t v) {
 }
 
 int run_camera_capture(const CaptureOptions& o);
+int run_bag_capture(const CaptureOptions& o);
 
 int run_capture(const CaptureOptions& o) {
   if (o.source == "camera") return run_camera_capture(o);
-  if (o.source != "sim") {
-    std::cerr << "avs calib capture: source '" << o.source
-              << "' is NOT IMPLEMENTED (issue 14: a bag source); 'sim' or 'camera'\n";
-    return 2;
-  }
+  if (o.source == "bag") return run_bag_capture(o);
   if (o.poses.empty() == (o.generate == 0)) {
     std::cerr << "avs calib capture: give either --poses FILE or --generate N\n";
     return 2;
@@ -214,14 +217,15 @@ int run_camera_capture(const CaptureOptions& o) {
   config.camera.height = o.height;
   config.camera.exposure_time_us = o.exposure_us;
   config.camera.gain = o.gain;
-  config.camera.frame_rate_hz = o.rate_hz;
+  const int rate_hz = o.rate_hz > 0 ? o.rate_hz : 1000;
+  config.camera.frame_rate_hz = rate_hz;
   config.camera.trigger_mode =
       o.trigger == "free_run" ? camera::TriggerMode::kFreeRun : camera::TriggerMode::kHardware;
   config.view_timeout = std::chrono::milliseconds(static_cast<long>(o.pose_timeout_s * 1000));
   projector::TransportOpener opener;
   if (o.projector != "none") {
     projector::LinkConfig link;
-    link.sequence = calib::calibration_sequence(info.codes, o.rate_hz, o.first_flash_image);
+    link.sequence = calib::calibration_sequence(info.codes, rate_hz, o.first_flash_image);
     config.projector = link;
     if (o.projector == "emulator") {
       // No hardware: avs's DLPC350 emulator with the flash the sequence needs (for a dry run
@@ -240,7 +244,7 @@ int run_camera_capture(const CaptureOptions& o) {
       "calibration capture from the camera: %zu frames per pose (white x %zu, black, %d column "
       "and %d row bits +/-) at %d Hz; projector %s\n",
       calib::projection_sequence(info.codes).size(), calib::kWhiteFrames,
-      info.codes.columns.bit_count, info.codes.rows.bit_count, o.rate_hz, o.projector.c_str());
+      info.codes.columns.bit_count, info.codes.rows.bit_count, rate_hz, o.projector.c_str());
   calib::CameraCapture capture(config, opener, info.codes, [](const std::string& line) {
     std::printf("  %s\n", line.c_str());
     std::fflush(stdout);
@@ -249,15 +253,15 @@ int run_camera_capture(const CaptureOptions& o) {
   const fs::path dir(o.out);
   calib::CaptureIndex index{info, {}};
   CaptureTally tally(index.info);
-  std::optional<calib::BoardView> previous;
+  std::vector<decode::GrayImage8> taken_whites;
   for (int v = 0; v < o.views; ++v) {
     std::printf(
         "pose %d/%d: put the board in a new pose and hold it still (taken when the view is "
         "new and still; %.0f s)\n",
         v + 1, o.views, o.pose_timeout_s);
     std::fflush(stdout);
-    std::optional<calib::BoardView> view = capture.capture_view(
-        pose_name(static_cast<std::size_t>(v)), previous ? &*previous : nullptr);
+    std::optional<calib::BoardView> view =
+        capture.capture_view(pose_name(static_cast<std::size_t>(v)), taken_whites);
     if (!view) {
       std::printf("pose %d/%d: no new still view within %.0f s: capture ends with %d poses\n",
                   v + 1, o.views, o.pose_timeout_s, v);
@@ -269,9 +273,60 @@ int run_camera_capture(const CaptureOptions& o) {
     std::printf("pose %d/%d %s captured: %s\n", v + 1, o.views, view->name.c_str(),
                 tally.add(*view).c_str());
     std::fflush(stdout);
-    previous = std::move(view);
+    taken_whites.push_back(view->frames[0]);
   }
   return tally.finish(dir);
+}
+
+int run_bag_capture(const CaptureOptions& o) {
+  if (o.bag.empty()) {
+    std::cerr << "avs calib capture: --source bag needs --bag FILE (a recording of " << o.topic
+              << ", e.g. by launch_config/calib_record.yaml)\n";
+    return 2;
+  }
+  calib::CaptureIndex index{camera_capture_info(o), {}};
+  index.info.source = "bag";
+  calib::BagCaptureConfig config;
+  config.topic = o.topic;
+  config.rate_hz = o.rate_hz;
+  config.dds_domain = o.domain;
+  const fs::path dir(o.out);
+  std::optional<CaptureTally> tally;
+  std::printf("calibration capture from %s (%s): every new still pose of the board\n",
+              o.bag.c_str(), o.topic.c_str());
+  const calib::BagCaptureStats stats = calib::capture_from_bag(
+      o.bag, index.info.codes, config,
+      [&](calib::BoardView&& view) {
+        if (!tally) {
+          // The camera's size is the recording's.
+          index.info.camera_width = view.frames[0].width;
+          index.info.camera_height = view.frames[0].height;
+          tally.emplace(index.info);
+        }
+        view.name = pose_name(index.views.size());
+        calib::write_view_frames(dir, view, index.info);
+        index.views.push_back({view.name, std::nullopt});
+        calib::write_capture_index(dir, index);
+        std::printf("pose %zu %s captured: %s\n", index.views.size(), view.name.c_str(),
+                    tally->add(view).c_str());
+        std::fflush(stdout);
+      },
+      [](const std::string& line) {
+        std::printf("  %s\n", line.c_str());
+        std::fflush(stdout);
+      });
+  std::printf(
+      "%lld messages: %lld views, %lld checked cycles of a pose already taken, %lld cycles "
+      "refused, %lld frames off the %.3f ms period grid, %lld unusable images\n",
+      static_cast<long long>(stats.messages), static_cast<long long>(stats.views),
+      static_cast<long long>(stats.same_pose), static_cast<long long>(stats.rejected_cycles),
+      static_cast<long long>(stats.off_grid), stats.period_ms,
+      static_cast<long long>(stats.bad_images));
+  if (!tally) {
+    std::printf("no view found in %s: WARNING, nothing captured\n", o.bag.c_str());
+    return 3;
+  }
+  return tally->finish(dir);
 }
 
 int run_calib_patterns(const CalibPatternsOptions& o) {
@@ -471,8 +526,9 @@ void add_calib_command(Command& app) {
   capture->add_option("--out", c.out, "capture folder (created)")->required();
   capture
       ->add_option("--source", c.source,
-                   "sim (the simulator) or camera (the rig: a GenICam camera through Aravis, "
-                   "the projector looping the calibration sequence); bag: not implemented")
+                   "sim (the simulator), camera (the rig: a GenICam camera through Aravis, "
+                   "the projector looping the calibration sequence) or bag (a recording of "
+                   "the rig's camera during a calibration session)")
       ->capture_default_str()
       ->check_member({"sim", "camera", "bag"});
   capture->add_option("--poses", c.poses, "board-pose YAML (board and a list of poses)")
@@ -513,8 +569,10 @@ void add_calib_command(Command& app) {
                    "camera: hardware (the projector's trigger out) or free_run")
       ->capture_default_str()
       ->check_member({"hardware", "free_run"});
-  capture->add_option("--rate", c.rate_hz, "camera and projector: patterns per second")
-      ->capture_default_str()
+  capture
+      ->add_option("--rate", c.rate_hz,
+                   "camera and bag: patterns per second (camera: default 1000; bag: default "
+                   "from the recording's stamps)")
       ->check_range(1, 4000);
   capture->add_option("--exposure-us", c.exposure_us, "camera: ExposureTime (0: leave it)")
       ->capture_default_str()
@@ -560,6 +618,11 @@ void add_calib_command(Command& app) {
   capture->add_option("--margin-mm", c.margin_mm, "camera: light border around the squares, mm")
       ->capture_default_str()
       ->check_range(0, 1000);
+  capture->add_option("--bag", c.bag, "bag: the recording (MCAP)")->check_existing_file();
+  capture
+      ->add_option("--topic", c.topic, "bag: the camera's image topic (sensor_msgs/Image, mono8)")
+      ->capture_default_str();
+  add_domain_option(capture, c.domain);
   capture->callback([] { guarded("capture", [] { return run_capture(c); }); });
 
   static CalibPatternsOptions p;

@@ -84,8 +84,8 @@ void CameraCapture::step_projector() {
   for (const projector::LinkEvent& e : projector_->step(Clock::now())) log_("projector: " + e.text);
 }
 
-std::optional<BoardView> CameraCapture::capture_view(const std::string& name,
-                                                     const BoardView* previous) {
+std::optional<BoardView> CameraCapture::capture_view(
+    const std::string& name, const std::vector<decode::GrayImage8>& taken_whites) {
   ViewAssembler assembler(codes_, config_.camera.width, config_.camera.height, config_.assembler);
   const Clock::time_point start = Clock::now();
   const Clock::time_point settled = start + config_.settle;
@@ -114,10 +114,10 @@ std::optional<BoardView> CameraCapture::capture_view(const std::string& name,
       if (result.rejected != last_rejection) log_(name + ": " + result.rejected);
       last_rejection = result.rejected;
     }
-    if (result.view && previous != nullptr && !previous->frames.empty() &&
-        changed_fraction(result.view->frames[0], previous->frames[0],
-                         config_.assembler.moved_threshold_dn) < config_.min_new_pose_fraction) {
-      result.rejected = "the same pose as the last view: waiting for the board to move";
+    if (result.view &&
+        !is_new_pose(*result.view, taken_whites, config_.assembler.moved_threshold_dn,
+                     config_.min_new_pose_fraction)) {
+      result.rejected = "a pose taken already: waiting for the board to move";
       if (result.rejected != last_rejection) log_(name + ": " + result.rejected);
       last_rejection = result.rejected;
       ++rejections;

@@ -179,7 +179,7 @@ std::vector<std::size_t> ViewAssembler::white_candidates(std::string& why) const
     std::snprintf(text, sizeof text,
                   "no %zu white frames followed by a black one (best: %.2f below the maximum "
                   "and %.2f above the minimum, of the lit level; at most %.2f each): not the "
-                  "calibration sequence (white x %zu, black, codes)",
+                  "calibration sequence (white x %zu, black, codes), or the scene changed during it",
                   k, below_max[w], above_min[(w + k) % n], config_.max_phase_distance, k);
     why = text;
   }
@@ -247,6 +247,45 @@ double changed_fraction(const decode::GrayImage8& a, const decode::GrayImage8& b
     changed += std::abs(int{a.pixels[i]} - int{b.pixels[i]}) > threshold_dn ? 1 : 0;
   }
   return a.pixels.empty() ? 0.0 : static_cast<double>(changed) / a.pixels.size();
+}
+
+bool is_new_pose(const BoardView& view, const std::vector<decode::GrayImage8>& taken_whites,
+                 int threshold_dn, double min_fraction) {
+  if (view.frames.empty()) return false;
+  return std::all_of(taken_whites.begin(), taken_whites.end(),
+                     [&](const decode::GrayImage8& white) {
+                       return changed_fraction(view.frames[0], white, threshold_dn) >= min_fraction;
+                     });
+}
+
+StampedFrameIds::StampedFrameIds(std::int64_t period_ns) : period_ns_(period_ns) {
+  if (period_ns < 1) throw std::invalid_argument("calib::StampedFrameIds: period must be > 0");
+}
+
+std::optional<std::uint64_t> StampedFrameIds::id(std::int64_t stamp_ns, std::string& why) {
+  if (!last_stamp_ns_) {
+    last_stamp_ns_ = stamp_ns;
+    return last_id_ = 1;
+  }
+  const std::int64_t step = stamp_ns - *last_stamp_ns_;
+  const std::int64_t periods = (step + period_ns_ / 2) / period_ns_;
+  const std::int64_t off = step - periods * period_ns_;
+  if (step <= 0 || periods < 1 || std::abs(off) * 4 > period_ns_) {
+    char text[160];
+    std::snprintf(
+        text, sizeof text,
+        "a frame %.3f ms after the last one on the period grid: not a whole number of pattern "
+        "periods of %.3f ms (wrong --rate, or stamps not from the camera)",
+        static_cast<double>(step) / 1e6, static_cast<double>(period_ns_) / 1e6);
+    why = text;
+    // Not on the grid of the frames before: an extra exposure, or a clock step. The frame is
+    // left out and the grid kept; a frame on it continues the run (an extra exposure does not
+    // move the projector's sequence), any other starts a new one.
+    return std::nullopt;
+  }
+  last_stamp_ns_ = stamp_ns;
+  last_id_ += static_cast<std::uint64_t>(periods);
+  return last_id_;
 }
 
 std::vector<FrameId> projection_sequence(const CaptureCodes& codes) {

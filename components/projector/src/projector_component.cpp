@@ -36,6 +36,7 @@ struct ProjectorConfig {
   int product_id = kUsbProductId;
   std::string serial;
   int bit_count = 9;              ///< n: 2n patterns per cycle (the camera's bit_count)
+  int pattern_count = 0;          ///< 0: 2n (the depth sequence); else this many from flash
   double pattern_rate_hz = 1000;  ///< the camera's frame_rate_hz: one fact for both
   int exposure_us = 0;            ///< 0: the whole pattern period
   SequenceConfig sequence;        ///< the rest of the sequence (counts and times from above)
@@ -100,6 +101,10 @@ class ProjectorComponent final : public runtime::Component {
             .integer("bit_count", AVS_FIELD(bit_count), 1, 64, "",
                      "n code bits: 2n 1-bit patterns per cycle in `avs patterns`' order (the "
                      "camera's and decode's bit_count)")
+            .integer("pattern_count", AVS_FIELD(pattern_count), 0, 128, "",
+                     "patterns per cycle; 0: 2 x bit_count (the depth sequence of `avs "
+                     "patterns`); the calibration sequence: the count `avs calib patterns` "
+                     "prints (38 for the paper's projector), with its first_flash_image")
             .real("pattern_rate_hz", AVS_FIELD(pattern_rate_hz), 0.01, 1e6, "Hz",
                   "patterns per second (the camera's frame_rate_hz); the period 1e6 / rate "
                   "must be whole microseconds")
@@ -198,7 +203,7 @@ class ProjectorComponent final : public runtime::Component {
                            " gives a period of " + std::to_string(period_us) +
                            " us; the DLPC350 takes whole microseconds");
     }
-    c.sequence.pattern_count = 2 * c.bit_count;
+    c.sequence.pattern_count = c.pattern_count > 0 ? c.pattern_count : 2 * c.bit_count;
     c.sequence.frame_period_us = static_cast<int>(std::lround(period_us));
     c.sequence.exposure_us = c.exposure_us > 0 ? c.exposure_us : c.sequence.frame_period_us;
     return c;

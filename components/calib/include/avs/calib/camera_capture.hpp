@@ -54,12 +54,12 @@ class CameraCapture {
   CameraCapture& operator=(const CameraCapture&) = delete;
 
   /// The frames of one board pose: drops `settle` worth of frames, then assembles a checked
-  /// cycle. With `previous` (the last view taken), a view whose white frame differs from
-  /// previous's in less than `min_new_pose_fraction` of the pixels is the same pose: skipped,
-  /// and the capture waits for the board to move. Returns nullopt after `view_timeout`
-  /// (every rejection was logged, once per reason in a row).
+  /// cycle. A view whose white frame differs from one of `taken_whites` (the white frames of the
+  /// views taken) in less than `min_new_pose_fraction` of the pixels is a pose taken already:
+  /// skipped, and the capture waits for the board to move. Returns nullopt after
+  /// `view_timeout` (every rejection was logged, once per reason in a row).
   std::optional<BoardView> capture_view(const std::string& name,
-                                        const BoardView* previous = nullptr);
+                                        const std::vector<decode::GrayImage8>& taken_whites = {});
 
   int width() const { return config_.camera.width; }
   int height() const { return config_.camera.height; }

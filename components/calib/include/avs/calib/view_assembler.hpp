@@ -93,6 +93,30 @@ class ViewAssembler {
   std::int64_t pushed_ = 0;
 };
 
+/// Whether `view` shows a pose not taken yet: its white frame differs from each of
+/// `taken_whites` (the white frames of the views taken) in at least `min_fraction` of the pixels
+/// by more than `threshold_dn`.
+bool is_new_pose(const BoardView& view, const std::vector<decode::GrayImage8>& taken_whites,
+                 int threshold_dn, double min_fraction);
+
+/// Frame ids for frames known by their stamps only (a recording of /camera/image_raw: the
+/// camera's stamps, one exposure per projector pattern): each step from the last frame on the
+/// grid must be a whole number of pattern periods, within a quarter period; the id advances by
+/// it (a step of k periods is k - 1 frames lost: the assembler starts again). A frame off the
+/// grid is left out and the grid kept.
+class StampedFrameIds {
+ public:
+  explicit StampedFrameIds(std::int64_t period_ns);
+  /// The frame's id (64 bits, from 1), or nullopt and why (off the period grid, or not after
+  /// the last frame on it).
+  std::optional<std::uint64_t> id(std::int64_t stamp_ns, std::string& why);
+
+ private:
+  std::int64_t period_ns_;
+  std::optional<std::int64_t> last_stamp_ns_;
+  std::uint64_t last_id_ = 0;
+};
+
 /// The fraction of pixels of `a` and `b` that differ by more than `threshold_dn` (1 when their
 /// sizes differ).
 double changed_fraction(const decode::GrayImage8& a, const decode::GrayImage8& b, int threshold_dn);
