@@ -96,7 +96,7 @@ TEST(ViewAssembler, FindsTheSequenceAtEveryPhaseAcrossAnIdWrap) {
   ASSERT_EQ(v.a.frames.size(), 36u);  // white, black, 8 column bits and 9 row bits, each +/-
   const std::size_t n = projection_sequence(v.info.codes).size();
   ASSERT_EQ(n, 38u);  // white three times
-  for (std::size_t phase = 0; phase < n; phase += 5) {
+  for (std::size_t phase = 0; phase < n; ++phase) {
     ViewAssembler assembler(v.info.codes, v.info.camera_width, v.info.camera_height);
     // A cycle of the previous pose's last frames, then this pose's cycles; ids wrap 65535 -> 1.
     const Fed fed =
@@ -168,10 +168,14 @@ TEST(ViewAssembler, NoProjectedSequenceGivesNoViewAndSaysWhy) {
   EXPECT_FALSE(fed.view);
   ASSERT_FALSE(fed.rejected.empty());
   EXPECT_NE(fed.rejected[0].find("calibration sequence"), std::string::npos) << fed.rejected[0];
-  // A frame of another size is refused with its size.
+  // A frame of another size, or with rows shorter than its width, is refused with its size.
   const std::vector<std::uint8_t> small(64 * 64);
   const AssemblerResult r = assembler.push(999, {small.data(), 64, 64, 0});
   EXPECT_NE(r.rejected.find("64 x 64"), std::string::npos) << r.rejected;
+  const AssemblerResult s = assembler.push(1000, {v.a.frames[0].pixels.data(), 512, 512, 100});
+  EXPECT_NE(s.rejected.find("rows of 100 bytes"), std::string::npos) << s.rejected;
+  const AssemblerResult t = assembler.push(1001, {v.a.frames[0].pixels.data(), 512, 512, -512});
+  EXPECT_FALSE(t.rejected.empty());
 }
 
 TEST(ViewAssembler, ACodeBitThatLooksLikeWhiteThenBlackDoesNotShiftTheLabels) {
@@ -192,6 +196,39 @@ TEST(ViewAssembler, ACodeBitThatLooksLikeWhiteThenBlackDoesNotShiftTheLabels) {
     ASSERT_TRUE(fed.view) << "phase " << phase;
     expect_frames_equal(*fed.view, phase == 0 ? odd : odd_again);
   }
+}
+
+TEST(StampedFrameIds, StepsOfWholePeriodsAreIdsOffGridFramesAreLeftOutANewGridIsTaken) {
+  constexpr std::int64_t kMs = 1000000;
+  StampedFrameIds ids(kMs);
+  std::string why;
+  EXPECT_EQ(ids.id(5 * kMs, why), 1u);
+  EXPECT_EQ(ids.id(6 * kMs + kMs / 5, why), 2u);  // jitter within a quarter period
+  EXPECT_EQ(ids.id(9 * kMs, why), 5u);            // two frames lost: the ids say so
+  EXPECT_FALSE(ids.id(9 * kMs + kMs / 2, why));   // an extra exposure off the grid
+  EXPECT_NE(why.find("not a whole number of pattern periods"), std::string::npos) << why;
+  EXPECT_EQ(ids.id(10 * kMs, why), 6u);  // the grid goes on
+  EXPECT_FALSE(ids.id(10 * kMs, why));   // not after the last one
+  // The sequence restarted half a period later: two frames off the grid, then the grid moves
+  // with a jump in the ids.
+  EXPECT_FALSE(ids.id(11 * kMs + kMs / 2, why));
+  EXPECT_FALSE(ids.id(12 * kMs + kMs / 2, why));
+  EXPECT_EQ(ids.id(13 * kMs + kMs / 2, why), 8u);
+  EXPECT_EQ(ids.id(14 * kMs + kMs / 2, why), 9u);
+}
+
+TEST(RepeatedReasons, SaysAReasonOnceAndHowOftenItCameInARow) {
+  std::vector<std::string> log;
+  RepeatedReasons reasons([&](const std::string& line) { log.push_back(line); });
+  reasons.add("frame id 12 after 9: frames lost");
+  reasons.add("frame id 40 after 37: frames lost");
+  reasons.add("frame id 90 after 81: frames lost");
+  reasons.add("the scene changed");
+  reasons.flush();
+  EXPECT_EQ(log, (std::vector<std::string>{"frame id 12 after 9: frames lost",
+                                           "(the same 3 times in a row)", "the scene changed"}));
+  EXPECT_EQ(reasons.total(), 4);
+  EXPECT_EQ(reasons.last(), "the scene changed");
 }
 
 TEST(ProjectorPattern, IsWhatTheSimulatorsProjectorShows) {

@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "dds_environment.hpp"
 #include "flash_images.hpp"
+#include "interrupts.hpp"
 
 #if __has_include("avs/calib/capture_folder.hpp")
 #include "avs/calib/bag_capture.hpp"
@@ -49,7 +50,11 @@ struct CaptureOptions {
   double gain = -1;
   int width = 512;
   int height = 512;
+  std::string trigger_source = "Line0";
+  std::string trigger_activation = "RisingEdge";
+  int socket_buffer_bytes = 16000000;
   std::string projector = "hid";
+  bool trigger_out_invert = false;
   std::string projector_serial;
   int first_flash_image = 1;
   double pose_timeout_s = 60;
@@ -147,6 +152,11 @@ int run_camera_capture(const CaptureOptions& o);
 int run_bag_capture(const CaptureOptions& o);
 
 int run_capture(const CaptureOptions& o) {
+  if (o.source != "sim" && (!o.poses.empty() || o.generate > 0)) {
+    std::cerr << "avs calib capture: --poses and --generate are for --source sim; the " << o.source
+              << " source captures the poses the board is put in\n";
+    return 2;
+  }
   if (o.source == "camera") return run_camera_capture(o);
   if (o.source == "bag") return run_bag_capture(o);
   if (o.poses.empty() == (o.generate == 0)) {
@@ -187,11 +197,14 @@ int run_capture(const CaptureOptions& o) {
   return tally.finish(dir);
 }
 
+/// The rig's nominal calibration (`--calibration`; default: the paper's sensor).
+decode::SensorGeometry nominal_geometry(const std::string& file) {
+  return file.empty() ? decode::default_sensor_geometry() : decode::load_sensor_geometry_yaml(file);
+}
+
 /// The capture's codes and the rig's depth layout from the rig's nominal calibration.
 calib::CaptureInfo camera_capture_info(const CaptureOptions& o) {
-  const decode::SensorGeometry nominal = o.calibration.empty()
-                                             ? decode::default_sensor_geometry()
-                                             : decode::load_sensor_geometry_yaml(o.calibration);
+  const decode::SensorGeometry nominal = nominal_geometry(o.calibration);
   calib::CaptureInfo info;
   info.source = "camera";
   info.board.squares_x = o.squares_x;
@@ -221,11 +234,19 @@ int run_camera_capture(const CaptureOptions& o) {
   config.camera.frame_rate_hz = rate_hz;
   config.camera.trigger_mode =
       o.trigger == "free_run" ? camera::TriggerMode::kFreeRun : camera::TriggerMode::kHardware;
+  config.camera.trigger_source = o.trigger_source;
+  config.camera.trigger_activation = o.trigger_activation;
+  config.camera.socket_buffer_bytes = o.socket_buffer_bytes;
+  // Ctrl-C ends the wait for a pose: the capture keeps the poses so far, the projector is
+  // stopped and the camera closed on the way out.
+  stop_on_interrupt();
+  config.interrupted = [] { return stop_requested().load(); };
   config.view_timeout = std::chrono::milliseconds(static_cast<long>(o.pose_timeout_s * 1000));
   projector::TransportOpener opener;
   if (o.projector != "none") {
     projector::LinkConfig link;
     link.sequence = calib::calibration_sequence(info.codes, rate_hz, o.first_flash_image);
+    link.sequence.trigger_out1.invert = o.trigger_out_invert;
     config.projector = link;
     if (o.projector == "emulator") {
       // No hardware: avs's DLPC350 emulator with the flash the sequence needs (for a dry run
@@ -263,8 +284,12 @@ int run_camera_capture(const CaptureOptions& o) {
     std::optional<calib::BoardView> view =
         capture.capture_view(pose_name(static_cast<std::size_t>(v)), taken_whites);
     if (!view) {
-      std::printf("pose %d/%d: no new still view within %.0f s: capture ends with %d poses\n",
-                  v + 1, o.views, o.pose_timeout_s, v);
+      std::printf("pose %d/%d: %s: capture ends with %d poses\n", v + 1, o.views,
+                  stop_requested() ? "interrupted"
+                                   : ("no new still view within " +
+                                      std::to_string(static_cast<int>(o.pose_timeout_s)) + " s")
+                                         .c_str(),
+                  v);
       break;
     }
     calib::write_view_frames(dir, *view, index.info);
@@ -330,9 +355,7 @@ int run_bag_capture(const CaptureOptions& o) {
 }
 
 int run_calib_patterns(const CalibPatternsOptions& o) {
-  const decode::SensorGeometry nominal = o.calibration.empty()
-                                             ? decode::default_sensor_geometry()
-                                             : decode::load_sensor_geometry_yaml(o.calibration);
+  const decode::SensorGeometry nominal = nominal_geometry(o.calibration);
   const calib::CaptureCodes codes = calib::calibration_codes(
       nominal.projector.width, nominal.projector.height, o.pixels_per_code);
   const fs::path dir(o.out);
@@ -344,7 +367,7 @@ int run_calib_patterns(const CalibPatternsOptions& o) {
   const std::vector<calib::FrameId> sequence = calib::projection_sequence(codes);
   for (std::size_t k = 0; k < sequence.size(); ++k) {
     const decode::GrayImage8 image = calib::projector_pattern(codes, sequence[k]);
-    const std::string frame = sequence[k].file_name().substr(0, sequence[k].file_name().size() - 4);
+    const std::string frame = sequence[k].label();
     char name[64];
     std::snprintf(name, sizeof name, "calib_%02zu_%s.png", k, frame.c_str());
     decode::write_png_gray8((dir / name).string(), image);
@@ -550,13 +573,16 @@ void add_calib_command(Command& app) {
   capture
       ->add_option("--calibration", c.calibration,
                    "sim: the simulated rig's true calibration (default: the bench's sensor, "
-                   "distortion on both lenses); camera: the rig's nominal calibration "
+                   "distortion on both lenses); camera and bag: the rig's nominal calibration "
                    "(projector size and depth code layout; default: the paper's)")
       ->check_existing_file();
   capture->add_option("--noise", c.noise_dn, "sensor noise sigma, DN")
       ->capture_default_str()
       ->check_range(0, 255);
-  capture->add_option("--pixels-per-code", c.pixels_per_code, "DMD pixels per code stripe")
+  capture
+      ->add_option("--pixels-per-code", c.pixels_per_code,
+                   "DMD pixels per code stripe (camera and bag: the value avs calib patterns "
+                   "wrote the flash images with)")
       ->capture_default_str()
       ->check_range(1, 64);
   capture->add_option("--views", c.views, "camera: board poses to capture")
@@ -587,6 +613,21 @@ void add_calib_command(Command& app) {
       ->capture_default_str()
       ->check_range(16, 16384);
   capture
+      ->add_option("--trigger-source", c.trigger_source,
+                   "camera: the input wired to the projector's trigger out")
+      ->capture_default_str();
+  capture
+      ->add_option("--trigger-activation", c.trigger_activation,
+                   "camera: RisingEdge for an active-high trigger out")
+      ->capture_default_str();
+  capture
+      ->add_option("--socket-buffer-bytes", c.socket_buffer_bytes,
+                   "camera: GigE Vision receive buffer (net.core.rmem_max at least this)")
+      ->capture_default_str()
+      ->check_range(0, 1e9);
+  capture->add_flag("--trigger-out-invert", c.trigger_out_invert,
+                    "camera: the projector's TRIG_OUT_1 active low");
+  capture
       ->add_option("--projector", c.projector,
                    "camera: hid (the LightCrafter 4500 over USB), emulator (avs's DLPC350 "
                    "emulator: a dry run, nothing projected) or none (it already loops the "
@@ -606,16 +647,18 @@ void add_calib_command(Command& app) {
                    "camera: seconds to wait for each new still pose")
       ->capture_default_str()
       ->check_range(0.1, 3600);
-  capture->add_option("--squares-x", c.squares_x, "camera: board squares along x")
+  capture->add_option("--squares-x", c.squares_x, "camera and bag: board squares along x")
       ->capture_default_str()
       ->check_range(3, 100);
-  capture->add_option("--squares-y", c.squares_y, "camera: board squares along y")
+  capture->add_option("--squares-y", c.squares_y, "camera and bag: board squares along y")
       ->capture_default_str()
       ->check_range(3, 100);
-  capture->add_option("--square-mm", c.square_mm, "camera: board square size, mm")
+  capture->add_option("--square-mm", c.square_mm, "camera and bag: board square size, mm")
       ->capture_default_str()
       ->check_range(1, 1000);
-  capture->add_option("--margin-mm", c.margin_mm, "camera: light border around the squares, mm")
+  capture
+      ->add_option("--margin-mm", c.margin_mm,
+                   "camera and bag: light border around the squares, mm")
       ->capture_default_str()
       ->check_range(0, 1000);
   capture->add_option("--bag", c.bag, "bag: the recording (MCAP)")->check_existing_file();

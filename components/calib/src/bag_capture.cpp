@@ -90,10 +90,9 @@ BagCaptureStats capture_from_bag(const std::filesystem::path& file, const Captur
   assembler_config.frame_id_zero_skipped = false;
   std::optional<ViewAssembler> assembler;
   std::vector<decode::GrayImage8> taken_whites;
-  std::string last_reason;
+  RepeatedReasons reasons(log);
   const auto note = [&](const std::string& reason) {
-    if (reason != last_reason) log(reason);
-    last_reason = reason;
+    reasons.add("message " + std::to_string(stats.messages) + ": " + reason);
   };
   while (const std::shared_ptr<const Image> image = reader.next()) {
     ++stats.messages;
@@ -109,9 +108,8 @@ BagCaptureStats capture_from_bag(const std::filesystem::path& file, const Captur
         image->step < image->width ||
         image->data._length < static_cast<std::uint64_t>(image->step) * image->height) {
       ++stats.bad_images;
-      note("message " + std::to_string(stats.messages) + ": a " + std::to_string(width) + " x " +
-           std::to_string(height) + " '" + encoding + "' image with " +
-           std::to_string(image->data._length) + " bytes; expected mono8 " +
+      note("a " + std::to_string(width) + " x " + std::to_string(height) + " '" + encoding +
+           "' image with " + std::to_string(image->data._length) + " bytes; expected mono8 " +
            std::to_string(stats.width) + " x " + std::to_string(stats.height) + ": not used");
       continue;
     }
@@ -119,14 +117,14 @@ BagCaptureStats capture_from_bag(const std::filesystem::path& file, const Captur
     const std::optional<std::uint64_t> id = ids.id(stamp_ns(*image), why);
     if (!id) {
       ++stats.off_grid;
-      note("message " + std::to_string(stats.messages) + ": " + why);
+      note(why);
       continue;
     }
     AssemblerResult result = assembler->push(
         *id, {image->data._buffer, width, height, static_cast<std::ptrdiff_t>(image->step)});
     if (!result.rejected.empty()) {
       ++stats.rejected_cycles;
-      note("message " + std::to_string(stats.messages) + ": " + result.rejected);
+      note(result.rejected);
     }
     if (!result.view) continue;
     if (!is_new_pose(*result.view, taken_whites, assembler_config.moved_threshold_dn,
@@ -134,10 +132,12 @@ BagCaptureStats capture_from_bag(const std::filesystem::path& file, const Captur
       ++stats.same_pose;
       continue;
     }
+    reasons.flush();
     ++stats.views;
     taken_whites.push_back(result.view->frames[0]);
     on_view(std::move(*result.view));
   }
+  reasons.flush();
   return stats;
 }
 

@@ -55,13 +55,26 @@ CameraCapture::CameraCapture(CameraCaptureConfig config,
     }
   }
   camera_ = std::make_unique<Camera>(config_.camera);
+  // GigE Vision block ids are 16 bits with 0 skipped; USB3 Vision's are 64 bits.
+  config_.assembler.frame_id_bits = camera_->device.is_gige() ? 16 : 64;
+  config_.assembler.frame_id_zero_skipped = camera_->device.is_gige();
   camera_->device.start();
 }
 
 CameraCapture::~CameraCapture() {
-  if (camera_) camera_->device.stop();
+  // A camera that left the network refuses AcquisitionStop: said, and the projector still
+  // stopped (a destructor must not throw).
+  try {
+    if (camera_) camera_->device.stop();
+  } catch (const std::exception& e) {
+    log_(std::string("camera: stopping: ") + e.what());
+  }
   if (projector_) {
-    for (const projector::LinkEvent& e : projector_->close()) log_("projector: " + e.text);
+    try {
+      for (const projector::LinkEvent& e : projector_->close()) log_("projector: " + e.text);
+    } catch (const std::exception& e) {
+      log_(std::string("projector: stopping: ") + e.what());
+    }
   }
 }
 
@@ -90,9 +103,8 @@ std::optional<BoardView> CameraCapture::capture_view(
   const Clock::time_point start = Clock::now();
   const Clock::time_point settled = start + config_.settle;
   const Clock::time_point until = settled + config_.view_timeout;
-  std::string last_rejection;
-  int rejections = 0;
-  while (Clock::now() < until) {
+  RepeatedReasons reasons([this, &name](const std::string& line) { log_(name + ": " + line); });
+  while (Clock::now() < until && !(config_.interrupted && config_.interrupted())) {
     step_projector();
     std::optional<camera::CapturedFrame> frame =
         camera_->device.next(std::chrono::milliseconds(100));
@@ -100,38 +112,33 @@ std::optional<BoardView> CameraCapture::capture_view(
     if (!frame->complete) {
       // An incomplete frame breaks the run of ids: the assembler starts again after it.
       assembler.reset();
-      ++rejections;
-      last_rejection =
-          "incomplete frame " + std::to_string(frame->frame_id) + " (" + frame->status + ")";
+      reasons.add("incomplete frame (" + frame->status + ")");
       continue;
     }
     // Frames exposed before the board was placed still come out of the buffers.
     if (Clock::now() < settled) continue;
     const decode::ImageView8 image{frame->data, frame->width, frame->height, frame->stride};
     AssemblerResult result = assembler.push(frame->frame_id, image);
-    if (!result.rejected.empty()) {
-      ++rejections;
-      if (result.rejected != last_rejection) log_(name + ": " + result.rejected);
-      last_rejection = result.rejected;
-    }
+    if (!result.rejected.empty()) reasons.add(result.rejected);
     if (result.view &&
         !is_new_pose(*result.view, taken_whites, config_.assembler.moved_threshold_dn,
                      config_.min_new_pose_fraction)) {
-      result.rejected = "a pose taken already: waiting for the board to move";
-      if (result.rejected != last_rejection) log_(name + ": " + result.rejected);
-      last_rejection = result.rejected;
-      ++rejections;
+      reasons.add("a pose taken already: waiting for the board to move");
       continue;
     }
     if (result.view) {
+      reasons.flush();
       result.view->name = name;
       return std::move(result.view);
     }
   }
-  log_(name + ": no checked view within " + std::to_string(config_.view_timeout.count()) + " ms (" +
-       std::to_string(assembler.frames_pushed()) + " frames, " + std::to_string(rejections) +
-       " rejections; last: " + (last_rejection.empty() ? "none, too few frames" : last_rejection) +
-       ")");
+  reasons.flush();
+  log_(name + ": no checked view " +
+       (Clock::now() < until ? std::string("(interrupted)")
+                             : "within " + std::to_string(config_.view_timeout.count()) + " ms") +
+       " (" + std::to_string(assembler.frames_pushed()) + " frames, " +
+       std::to_string(reasons.total()) + " rejections; last: " +
+       (reasons.last().empty() ? "none, too few frames" : reasons.last()) + ")");
   return std::nullopt;
 }
 

@@ -61,6 +61,11 @@ std::string FrameId::file_name() const {
   return {};
 }
 
+std::string FrameId::label() const {
+  const std::string name = file_name();
+  return name.substr(0, name.size() - 4);
+}
+
 CaptureCodes calibration_codes(int projector_width, int projector_height, int pixels_per_code) {
   if (pixels_per_code < 1 || pixels_per_code > projector_width / 4 ||
       pixels_per_code > projector_height / 4) {

@@ -8,15 +8,6 @@
 #include "avs/decode/patterns.hpp"
 
 namespace avs::calib {
-namespace {
-
-std::string frame_label(const FrameId& id) {
-  const std::string name = id.file_name();
-  return name.substr(0, name.size() - 4);  // without ".png"
-}
-
-}  // namespace
-
 ViewAssembler::ViewAssembler(const CaptureCodes& codes, int width, int height,
                              AssemblerConfig config)
     : frames_(projection_sequence(codes)), width_(width), height_(height), config_(config) {
@@ -42,11 +33,13 @@ bool ViewAssembler::follows(std::uint64_t previous, std::uint64_t id) const {
 AssemblerResult ViewAssembler::push(std::uint64_t frame_id, const decode::ImageView8& image) {
   ++pushed_;
   AssemblerResult result;
-  if (image.width != width_ || image.height != height_ || image.data == nullptr) {
-    char why[128];
-    std::snprintf(why, sizeof why, "frame %llu is %d x %d, expected %d x %d: ignored",
-                  static_cast<unsigned long long>(frame_id), image.width, image.height, width_,
-                  height_);
+  if (image.width != width_ || image.height != height_ || image.data == nullptr ||
+      image.stride_bytes < 0 || (image.stride_bytes > 0 && image.stride_bytes < image.width)) {
+    char why[160];
+    std::snprintf(why, sizeof why,
+                  "frame %llu is %d x %d with rows of %td bytes, expected %d x %d: ignored",
+                  static_cast<unsigned long long>(frame_id), image.width, image.height,
+                  image.stride_bytes, width_, height_);
     result.rejected = why;
     return result;
   }
@@ -69,9 +62,9 @@ AssemblerResult ViewAssembler::push(std::uint64_t frame_id, const decode::ImageV
   run_.push_back(std::move(copy));
 
   // The white frame of the first cycle lies within the first N frames of the run; its check
-  // needs the frame N after it (the next white) too.
+  // needs the frame N after it (the next white) too: an index of at most 2N - 1.
   const std::size_t n = frames_.size();
-  if (run_.size() < 2 * n + 1) return result;
+  if (run_.size() < 2 * n) return result;
   // Every phase consistent with the whole sequence; one is a view, more are ambiguous.
   std::string why;
   std::vector<std::size_t> consistent;
@@ -176,11 +169,12 @@ std::vector<std::size_t> ViewAssembler::white_candidates(std::string& why) const
   if (candidates.empty()) {
     std::size_t w = 0;
     for (std::size_t f = 1; f < n; ++f) w = score[f] < score[w] ? f : w;
-    std::snprintf(text, sizeof text,
-                  "no %zu white frames followed by a black one (best: %.2f below the maximum "
-                  "and %.2f above the minimum, of the lit level; at most %.2f each): not the "
-                  "calibration sequence (white x %zu, black, codes), or the scene changed during it",
-                  k, below_max[w], above_min[(w + k) % n], config_.max_phase_distance, k);
+    std::snprintf(
+        text, sizeof text,
+        "no %zu white frames followed by a black one (best: %.2f below the maximum "
+        "and %.2f above the minimum, of the lit level; at most %.2f each): not the "
+        "calibration sequence (white x %zu, black, codes), or the scene changed during it",
+        k, below_max[w], above_min[(w + k) % n], config_.max_phase_distance, k);
     why = text;
   }
   return candidates;
@@ -224,7 +218,7 @@ std::string ViewAssembler::check_cycle(std::size_t w) const {
                     "frames %zu and %zu from the first white one are not the complementary pair %s "
                     "(mismatch %.2f of the lit level, at most %.2f): a frame slipped, or the "
                     "projector shows another sequence",
-                    f, f + 1, frame_label(frames_[f]).c_str(), mismatch, config_.max_pair_mismatch);
+                    f, f + 1, frames_[f].label().c_str(), mismatch, config_.max_pair_mismatch);
       return why;
     }
   }
@@ -249,6 +243,30 @@ double changed_fraction(const decode::GrayImage8& a, const decode::GrayImage8& b
   return a.pixels.empty() ? 0.0 : static_cast<double>(changed) / a.pixels.size();
 }
 
+void RepeatedReasons::add(const std::string& reason) {
+  ++total_;
+  std::string key;
+  for (const char c : reason) {
+    if ((c < '0' || c > '9') && c != '.' && c != '-' && c != '+') key.push_back(c);
+  }
+  if (key == last_key_) {
+    ++repeats_;
+    last_ = reason;
+    return;
+  }
+  flush();
+  log_(reason);
+  last_ = reason;
+  last_key_ = std::move(key);
+  repeats_ = 1;
+}
+
+void RepeatedReasons::flush() {
+  if (repeats_ > 1) log_("(the same " + std::to_string(repeats_) + " times in a row)");
+  repeats_ = 0;
+  last_key_.clear();
+}
+
 bool is_new_pose(const BoardView& view, const std::vector<decode::GrayImage8>& taken_whites,
                  int threshold_dn, double min_fraction) {
   if (view.frames.empty()) return false;
@@ -262,30 +280,45 @@ StampedFrameIds::StampedFrameIds(std::int64_t period_ns) : period_ns_(period_ns)
   if (period_ns < 1) throw std::invalid_argument("calib::StampedFrameIds: period must be > 0");
 }
 
+std::int64_t StampedFrameIds::periods_between(std::int64_t from_ns, std::int64_t stamp_ns) const {
+  const std::int64_t step = stamp_ns - from_ns;
+  if (step <= 0) return 0;
+  const std::int64_t periods = (step + period_ns_ / 2) / period_ns_;
+  const std::int64_t off = step - periods * period_ns_;
+  return periods >= 1 && std::abs(off) * 4 <= period_ns_ ? periods : 0;
+}
+
 std::optional<std::uint64_t> StampedFrameIds::id(std::int64_t stamp_ns, std::string& why) {
   if (!last_stamp_ns_) {
     last_stamp_ns_ = stamp_ns;
     return last_id_ = 1;
   }
-  const std::int64_t step = stamp_ns - *last_stamp_ns_;
-  const std::int64_t periods = (step + period_ns_ / 2) / period_ns_;
-  const std::int64_t off = step - periods * period_ns_;
-  if (step <= 0 || periods < 1 || std::abs(off) * 4 > period_ns_) {
-    char text[160];
-    std::snprintf(
-        text, sizeof text,
-        "a frame %.3f ms after the last one on the period grid: not a whole number of pattern "
-        "periods of %.3f ms (wrong --rate, or stamps not from the camera)",
-        static_cast<double>(step) / 1e6, static_cast<double>(period_ns_) / 1e6);
-    why = text;
-    // Not on the grid of the frames before: an extra exposure, or a clock step. The frame is
-    // left out and the grid kept; a frame on it continues the run (an extra exposure does not
-    // move the projector's sequence), any other starts a new one.
-    return std::nullopt;
+  if (const std::int64_t periods = periods_between(*last_stamp_ns_, stamp_ns); periods > 0) {
+    off_grid_run_ = 0;
+    last_stamp_ns_ = stamp_ns;
+    last_id_ += static_cast<std::uint64_t>(periods);
+    return last_id_;
   }
-  last_stamp_ns_ = stamp_ns;
-  last_id_ += static_cast<std::uint64_t>(periods);
-  return last_id_;
+  off_grid_run_ = off_grid_run_ > 0 && periods_between(off_grid_stamp_ns_, stamp_ns) > 0
+                      ? off_grid_run_ + 1
+                      : 1;
+  off_grid_stamp_ns_ = stamp_ns;
+  if (off_grid_run_ >= kNewGridFrames) {
+    // A grid of their own: the sequence restarted at another phase. From here on, with a gap
+    // in the ids so that no run spans the two grids.
+    off_grid_run_ = 0;
+    last_stamp_ns_ = stamp_ns;
+    last_id_ += 2;
+    return last_id_;
+  }
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "a frame %.3f ms after the last one on the period grid: not a whole number of "
+                "pattern periods of %.3f ms (wrong --rate, or stamps not from the camera)",
+                static_cast<double>(stamp_ns - *last_stamp_ns_) / 1e6,
+                static_cast<double>(period_ns_) / 1e6);
+  why = text;
+  return std::nullopt;
 }
 
 std::vector<FrameId> projection_sequence(const CaptureCodes& codes) {

@@ -5,7 +5,7 @@
 // publishing every frame (`image_raw_rate_hz` above its frame rate), the board moved through
 // its poses (launch_config/calib_record.yaml). Frames get ids from their stamps
 // (StampedFrameIds), ViewAssembler finds the checked cycles, and every cycle of a new pose
-// (is_new_pose against the last view taken) is one view.
+// (is_new_pose against every view taken) is one view.
 #pragma once
 
 #include <cstdint>

@@ -32,6 +32,8 @@ struct CameraCaptureConfig {
   /// A new pose changes at least this fraction of the white frame's pixels (by more than
   /// assembler.moved_threshold_dn).
   double min_new_pose_fraction = 0.02;
+  /// Polled while waiting for a view: true ends the wait (Ctrl-C); empty: never.
+  std::function<bool()> interrupted;
   std::chrono::milliseconds projector_start_timeout{5000};
 };
 
@@ -57,7 +59,8 @@ class CameraCapture {
   /// cycle. A view whose white frame differs from one of `taken_whites` (the white frames of the
   /// views taken) in less than `min_new_pose_fraction` of the pixels is a pose taken already:
   /// skipped, and the capture waits for the board to move. Returns nullopt after
-  /// `view_timeout` (every rejection was logged, once per reason in a row).
+  /// `view_timeout` or when `interrupted` says so (the rejections logged, each reason once in a
+  /// row with its count).
   std::optional<BoardView> capture_view(const std::string& name,
                                         const std::vector<decode::GrayImage8>& taken_whites = {});
 

@@ -28,6 +28,8 @@ struct FrameId {
   bool positive = true;
   /// File name in a capture folder: white.png, black.png, column_03_pos.png, row_10_neg.png.
   std::string file_name() const;
+  /// The same without ".png": white, column_03_pos.
+  std::string label() const;
 };
 
 /// The calibration codes over the projector's DMD: Gray codes of its columns and of its rows

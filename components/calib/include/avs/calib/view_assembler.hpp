@@ -31,6 +31,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -93,6 +94,26 @@ class ViewAssembler {
   std::int64_t pushed_ = 0;
 };
 
+/// Reasons for frames and cycles not used, told without flooding the log: a reason is passed to
+/// `log` when it differs from the one before (ignoring its numbers: "frame id 12 after 9" and
+/// "frame id 40 after 37" are the same reason), and when another comes, or at flush(), how many
+/// times the one before came in a row.
+class RepeatedReasons {
+ public:
+  explicit RepeatedReasons(std::function<void(const std::string&)> log) : log_(std::move(log)) {}
+  void add(const std::string& reason);
+  void flush();
+  std::int64_t total() const { return total_; }
+  const std::string& last() const { return last_; }
+
+ private:
+  std::function<void(const std::string&)> log_;
+  std::string last_;
+  std::string last_key_;
+  std::int64_t repeats_ = 0;
+  std::int64_t total_ = 0;
+};
+
 /// Whether `view` shows a pose not taken yet: its white frame differs from each of
 /// `taken_whites` (the white frames of the views taken) in at least `min_fraction` of the pixels
 /// by more than `threshold_dn`.
@@ -103,18 +124,26 @@ bool is_new_pose(const BoardView& view, const std::vector<decode::GrayImage8>& t
 /// camera's stamps, one exposure per projector pattern): each step from the last frame on the
 /// grid must be a whole number of pattern periods, within a quarter period; the id advances by
 /// it (a step of k periods is k - 1 frames lost: the assembler starts again). A frame off the
-/// grid is left out and the grid kept.
+/// grid is left out and the grid kept, unless kNewGridFrames frames in a row are off it and on
+/// a grid of their own (the camera or the projector restarted at another phase): the grid then
+/// moves to them, with a jump in the ids (the assembler starts again).
 class StampedFrameIds {
  public:
+  static constexpr int kNewGridFrames = 3;
   explicit StampedFrameIds(std::int64_t period_ns);
   /// The frame's id (64 bits, from 1), or nullopt and why (off the period grid, or not after
   /// the last frame on it).
   std::optional<std::uint64_t> id(std::int64_t stamp_ns, std::string& why);
 
  private:
+  /// Whole periods from `from_ns` to `stamp_ns` (>= 1), or 0 when not on that grid.
+  std::int64_t periods_between(std::int64_t from_ns, std::int64_t stamp_ns) const;
+
   std::int64_t period_ns_;
   std::optional<std::int64_t> last_stamp_ns_;
   std::uint64_t last_id_ = 0;
+  std::int64_t off_grid_stamp_ns_ = 0;  ///< the last frame off the grid
+  int off_grid_run_ = 0;                ///< frames in a row off the grid, on a grid of their own
 };
 
 /// The fraction of pixels of `a` and `b` that differ by more than `threshold_dn` (1 when their
