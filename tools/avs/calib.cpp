@@ -259,9 +259,18 @@ int run_camera_capture(const CaptureOptions& o) {
       opener = projector::emulator_opener(std::make_shared<projector::Dlpc350Emulator>(
           projector::EmulatorConfig{.flash_image_count = images, .busy_reads = 1}));
     } else {
+      std::printf(
+          "WARNING: the USB HID path to a real LightCrafter 4500 (hidapi) is NOT exercised by "
+          "avs's tests (no projector on the test machine; the DLPC350 protocol is tested "
+          "against avs's emulator only)\n");
       opener = projector::hidapi_opener(
           {projector::kUsbVendorId, projector::kUsbProductId, o.projector_serial});
     }
+  }
+  if (config.camera.trigger_mode == camera::TriggerMode::kHardware) {
+    std::printf(
+        "WARNING: the camera's hardware trigger is NOT exercised by avs's tests (Aravis's fake "
+        "camera only free-runs)\n");
   }
   std::printf(
       "calibration capture from the camera: %zu frames per pose (white x %zu, black, %d column "
