@@ -1,4 +1,5 @@
 // Sub-code refinement (components/decode/src/subcode.hpp) on synthetic code staircases.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -101,6 +102,123 @@ TEST(SubcodeRefiner, InvalidPixelsStayInvalidAndGapsAreTolerated) {
   }
   EXPECT_LT(rms_error(c, refined, 4, kHeight - 4, false),
             0.4 * rms_error(c, refined, 4, kHeight - 4, true));
+}
+
+// The refiner's definition written the slow way, one pixel at a time: the window's valid codes
+// enumerated, each one's discontinuity flag found by walking up its column, the line fit from
+// 64-bit sums about the pixel (d = y - y0) and the same float division as the refiner.
+std::vector<float> refine_by_definition(const std::vector<std::int16_t>& codes, int width,
+                                        int height, int half, int max_jump) {
+  const auto code_at = [&](int x, int y) { return codes[static_cast<std::size_t>(y) * width + x]; };
+  const auto jump_at = [&](int x, int y) {
+    if (code_at(x, y) < 0) return false;
+    for (int above = y - 1; above >= 0; --above) {
+      if (code_at(x, above) < 0) continue;
+      const int gap = y - above;
+      return gap <= 2 * half && std::abs(code_at(x, y) - code_at(x, above)) > max_jump * gap;
+    }
+    return false;
+  };
+  std::vector<float> refined(codes.size(), std::numeric_limits<float>::quiet_NaN());
+  for (int y0 = 0; y0 < height; ++y0) {
+    for (int x = 0; x < width; ++x) {
+      const int c0 = code_at(x, y0);
+      if (c0 < 0) continue;
+      std::int64_t n = 0, sd = 0, sdd = 0, sc = 0, scd = 0;
+      bool jump = false;
+      for (int y = std::max(0, y0 - half); y <= std::min(height - 1, y0 + half); ++y) {
+        const int c = code_at(x, y);
+        if (c < 0) continue;
+        const int d = y - y0;
+        n += 1;
+        sd += d;
+        sdd += d * d;
+        sc += c;
+        scd += c * d;
+        jump = jump || jump_at(x, y);
+      }
+      const std::int64_t det = n * sdd - sd * sd;
+      const auto c = static_cast<float>(c0);
+      float u = c;
+      if (!jump && n >= 3 && det > 0) {
+        const float intercept =
+            sd == 0 ? static_cast<float>(sc) / static_cast<float>(n)  // the mean
+                    : static_cast<float>(sc * sdd - scd * sd) / static_cast<float>(det);
+        u = std::min(std::max(intercept, c - 1.0f), c + 1.0f);
+      }
+      refined[static_cast<std::size_t>(y0) * width + x] = u;
+    }
+  }
+  return refined;
+}
+
+// The sliding-window refiner (running sums; plain and AVX2) equals its definition bit for bit on
+// noisy staircases with holes and discontinuities, for every window size; widths that leave a
+// remainder after the 8-column blocks; a window taller than the image.
+TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
+  std::mt19937 random(11);
+  int narrow_runs = 0;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const auto& [width, height] : {std::pair{37, 90}, std::pair{16, 7}}) {
+    std::vector<std::int16_t> codes(static_cast<std::size_t>(width) * height);
+    for (int x = 0; x < width; ++x) {
+      double f = 40.0 + 3.0 * x;
+      const double slope = 0.1 + 0.9 * unit(random);
+      for (int y = 0; y < height; ++y) {
+        f += slope + (unit(random) < 0.03 ? 30.0 * (unit(random) - 0.5) : 0.0);
+        const double noisy = f + 0.4 * (unit(random) - 0.5);
+        codes[static_cast<std::size_t>(y) * width + x] =
+            unit(random) < 0.12 ? std::int16_t{-1} : quantise(std::max(noisy, 0.0));
+      }
+    }
+    // With the largest code known the AVX2 step takes 16-bit sums where they are exact (half
+    // windows up to 7 here), without it 32-bit ones.
+    const int code_count = *std::max_element(codes.begin(), codes.end()) + 1;
+    std::vector<std::pair<KernelIsa, int>> configurations{{KernelIsa::kScalar, code_count}};
+    if (best_kernel_isa() == KernelIsa::kAvx2) {
+      configurations.emplace_back(KernelIsa::kAvx2, 0);
+      configurations.emplace_back(KernelIsa::kAvx2, code_count);
+    }
+    for (const int half : {1, 2, 4, 7, 16}) {
+      for (const int max_jump : {0, 2, 5}) {
+        const std::vector<float> expected =
+            refine_by_definition(codes, width, height, half, max_jump);
+        for (const auto& [isa, code_count] : configurations) {
+          SubcodeRefiner refiner({width, height, half, max_jump, code_count}, isa);
+          narrow_runs += refiner.narrow_sums() ? 1 : 0;
+          std::vector<float> refined(codes.size());
+          refiner.refine(codes.data(), refined.data());
+          int refined_pixels = 0;
+          for (std::size_t i = 0; i < codes.size(); ++i) {
+            refined_pixels += codes[i] >= 0 && refined[i] != static_cast<float>(codes[i]) ? 1 : 0;
+          }
+          if (height > 2 * half && max_jump >= 2) {  // 0: every code change is a jump
+            EXPECT_GT(refined_pixels, 0) << "half " << half;
+          }
+          ASSERT_EQ(std::memcmp(refined.data(), expected.data(), refined.size() * sizeof(float)), 0)
+              << kernel_isa_name(isa) << ", largest code " << code_count - 1 << ", " << width << "x"
+              << height << ", half window " << half << ", max jump " << max_jump;
+        }
+      }
+    }
+  }
+  EXPECT_GT(narrow_runs, 0) << "the 16-bit sums were compared too";
+}
+
+// What the AVX2 step relies on to take the mean of a complete window without a division: for
+// an odd window of n rows (3 .. 33) and every possible code sum (codes are int16), sc * (1 / n)
+// in double, rounded to float, is the float division sc / n bit for bit.
+TEST(SubcodeRefiner, TheMeanByAReciprocalIsTheFloatDivision) {
+  for (int n = 3; n <= 33; n += 2) {
+    const double inverse = 1.0 / n;
+    int differing = 0;
+    for (std::int32_t sc = 0; sc <= n * 32767; ++sc) {
+      const float divided = static_cast<float>(sc) / static_cast<float>(n);
+      const auto multiplied = static_cast<float>(static_cast<double>(sc) * inverse);
+      differing += divided != multiplied ? 1 : 0;
+    }
+    EXPECT_EQ(differing, 0) << "window of " << n << " rows";
+  }
 }
 
 TEST(SubcodeRefiner, RejectsBadParameters) {

@@ -53,7 +53,8 @@ std::unique_ptr<detail::SubcodeRefiner> make_refiner(const DecoderConfig& c) {
   }
   return std::make_unique<detail::SubcodeRefiner>(
       detail::SubcodeParams{c.geometry.camera.width, c.geometry.camera.height,
-                            c.subcode_half_window, c.subcode_max_jump});
+                            c.subcode_half_window, c.subcode_max_jump,
+                            c.geometry.layout.code_count});
 }
 
 /// Depth from fractional codes through the sub-code planes (NaN codes give NaN), all pixels.
