@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 #include <stdexcept>
@@ -19,6 +20,7 @@
 #include <opencv2/structured_light.hpp>
 
 #include "../src/rolling_kernel.hpp"
+#include "../src/subcode.hpp"
 #include "avs/bench/report.hpp"
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/decode/synthetic_plane.hpp"
@@ -83,6 +85,117 @@ RollingTiming time_rolling(const DecoderConfig& config, const SyntheticScene& sc
   }
   t.rms_error_m = std::sqrt(sum / std::max(valid, 1));
   return t;
+}
+
+// The plain update and the update with sub-code refinement timed in alternation on the same
+// pairs (which one goes first alternates too), so that both medians see the same machine: on a
+// shared host the separate timings above moved by tens of per cent between sections of a run.
+struct InterleavedTiming {
+  double plain_ms = 0;
+  double subcode_ms = 0;
+};
+
+InterleavedTiming time_interleaved(const DecoderConfig& plain_config,
+                                   const DecoderConfig& subcode_config, const SyntheticScene& scene,
+                                   int updates) {
+  RollingDecoder plain(plain_config);
+  RollingDecoder subcode(subcode_config);
+  const int n = plain_config.geometry.layout.bit_count;
+  for (int k = 0; k < n; ++k) {  // fill both windows
+    for (RollingDecoder* decoder : {&plain, &subcode}) {
+      decoder->push_pair(scene.frame(k, Polarity::kPositive, 0).image,
+                         scene.frame(k, Polarity::kNegative, 0).image, k, 0);
+    }
+  }
+  std::vector<double> plain_ms, subcode_ms;
+  std::int64_t cycle = 0;
+  for (int u = 0; u < updates; ++u) {
+    const int k = u % n;
+    if (k == 0) ++cycle;
+    const PatternFrame positive = scene.frame(k, Polarity::kPositive, cycle);
+    const PatternFrame negative = scene.frame(k, Polarity::kNegative, cycle);
+    const auto update = [&](RollingDecoder& decoder) {
+      return time_ms([&] {
+        decoder.push_frame(positive);
+        decoder.push_frame(negative);
+      });
+    };
+    if (u % 2 == 0) {
+      plain_ms.push_back(update(plain));
+      subcode_ms.push_back(update(subcode));
+    } else {
+      subcode_ms.push_back(update(subcode));
+      plain_ms.push_back(update(plain));
+    }
+  }
+  return {median(plain_ms), median(subcode_ms)};
+}
+
+// The three passes of the sub-code update timed apart (medians), on the codes of a full-cycle
+// decode of the scene: Gray words to codes, the window's line fit, the sub-code plane look-up.
+struct SubcodePasses {
+  double gray_to_code_ms = 0;
+  double window_ms = 0;
+  double lookup_ms = 0;
+};
+
+SubcodePasses time_subcode_passes(const DecoderConfig& config, const SyntheticScene& scene,
+                                  int updates) {
+  const SensorGeometry& g = config.geometry;
+  const int n = g.layout.bit_count;
+  std::vector<PatternFrame> frames;
+  for (int k = 0; k < n; ++k) {
+    frames.push_back(scene.frame(k, Polarity::kPositive, 0));
+    frames.push_back(scene.frame(k, Polarity::kNegative, 0));
+  }
+  const FullCycleResult decoded = decode_full_cycle(config, frames);
+  const auto pixels = static_cast<int>(decoded.code.size());
+  const auto full = static_cast<std::uint16_t>((1u << n) - 1u);
+  std::vector<std::uint16_t> gray(decoded.code.size()), valid(decoded.code.size());
+  for (std::size_t i = 0; i < decoded.code.size(); ++i) {
+    const auto code = static_cast<std::uint16_t>(std::max(decoded.code[i], 0));
+    gray[i] = static_cast<std::uint16_t>(code ^ (code >> 1));
+    valid[i] = decoded.code[i] >= 0 ? full : 0;
+  }
+  const DepthTable table(g, config.subcode_steps);
+  detail::SubcodeRefiner refiner({g.camera.width, g.camera.height, config.subcode_half_window,
+                                  config.subcode_max_jump, g.layout.code_count});
+  std::vector<std::int16_t> codes(decoded.code.size());
+  std::vector<float> refined(decoded.code.size()), depth(decoded.code.size());
+  const detail::SubcodePlanes planes{table.subcode_planes(), table.subcode_steps(),
+                                     table.subcode_plane_count()};
+  std::vector<double> gray_ms, window_ms, lookup_ms;
+  for (int u = 0; u < updates; ++u) {
+    gray_ms.push_back(time_ms([&] {
+      detail::codes_from_gray(gray.data(), valid.data(), full, g.layout.code_count, codes.data(),
+                              pixels);
+    }));
+    window_ms.push_back(time_ms([&] { refiner.refine(codes.data(), refined.data()); }));
+    lookup_ms.push_back(time_ms([&] {
+      detail::triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(),
+                                  config.min_depth_m, config.max_depth_m, depth.data(), pixels);
+    }));
+  }
+  return {median(gray_ms), median(window_ms), median(lookup_ms)};
+}
+
+// FNV-1a over the bytes of every depth map of three cycles: equal between two commits when
+// their decoders give bit-identical maps (a speed change must not change a result).
+std::uint64_t hash_depth_maps(const DecoderConfig& config, const SyntheticScene& scene) {
+  RollingDecoder decoder(config);
+  const int n = config.geometry.layout.bit_count;
+  std::uint64_t hash = 14695981039346656037ull;
+  for (int u = 0; u < 3 * n; ++u) {
+    const int k = u % n;
+    const std::int64_t cycle = u / n;
+    decoder.push_frame(scene.frame(k, Polarity::kPositive, cycle));
+    const auto depth = decoder.push_frame(scene.frame(k, Polarity::kNegative, cycle)).depth_m;
+    const auto* bytes = reinterpret_cast<const unsigned char*>(depth.data());
+    for (std::size_t i = 0; i < depth.size() * sizeof(float); ++i) {
+      hash = (hash ^ bytes[i]) * 1099511628211ull;
+    }
+  }
+  return hash;
 }
 
 struct OpenCvTiming {
@@ -218,6 +331,9 @@ bench::Report run(const std::vector<std::string>& args) {
   DecoderConfig subcode_config = config;
   subcode_config.subcode_half_window = 4;
   const RollingTiming subcode = time_rolling(subcode_config, scene, updates);
+  const InterleavedTiming interleaved = time_interleaved(config, subcode_config, scene, updates);
+  const double subcode_cost = interleaved.subcode_ms / interleaved.plain_ms;
+  const SubcodePasses passes = time_subcode_passes(subcode_config, scene, updates);
   const OpenCvTiming opencv =
       time_opencv(config.geometry, scene, config.threshold_psi, opencv_runs);
 
@@ -240,7 +356,16 @@ bench::Report run(const std::vector<std::string>& args) {
                          distorted.push_frames_ms, "", 0});
   report.rows.push_back({"rolling update + sub-code refinement (h = 4, optional)", "ms",
                          subcode.push_frames_ms, "", 0});
+  report.rows.push_back({"update + sub-code refinement, plain update timed in alternation", "ms",
+                         interleaved.subcode_ms, "plain update, same pairs, alternating",
+                         interleaved.plain_ms});
   report.json = {{"avs_update_ms", avs.push_frames_ms},
+                 {"interleaved_update_ms", interleaved.plain_ms},
+                 {"interleaved_update_subcode_ms", interleaved.subcode_ms},
+                 {"subcode_cost_ratio", subcode_cost},
+                 {"subcode_gray_to_code_ms", passes.gray_to_code_ms},
+                 {"subcode_window_ms", passes.window_ms},
+                 {"subcode_lookup_ms", passes.lookup_ms},
                  {"avs_update_subcode_ms", subcode.push_frames_ms},
                  {"avs_subcode_rms_error_mm", 1e3 * subcode.rms_error_m},
                  {"avs_update_pair_ms", avs.push_pair_ms},
@@ -270,6 +395,22 @@ bench::Report run(const std::vector<std::string>& args) {
       "(it has no rolling mode), so its figure is per 9-bit map, ours per 1-bit update");
   report.notes.push_back(
       "OpenCV x_p for triangulatePoints comes from the epipolar line (not timed)");
+  std::snprintf(line, sizeof line,
+                "depth maps of 3 cycles, FNV-1a: plain %016llx, sub-code (h = 4) %016llx (equal "
+                "across commits = bit-identical decoding)",
+                static_cast<unsigned long long>(hash_depth_maps(config, scene)),
+                static_cast<unsigned long long>(hash_depth_maps(subcode_config, scene)));
+  report.notes.push_back(line);
+  std::snprintf(line, sizeof line,
+                "sub-code passes apart (h = 4): Gray to code %.3f ms, window fit %.3f ms, plane "
+                "look-up %.3f ms",
+                passes.gray_to_code_ms, passes.window_ms, passes.lookup_ms);
+  report.notes.push_back(line);
+  std::snprintf(line, sizeof line,
+                "sub-code refinement costs %.2fx the plain update, timed in alternation "
+                "(subcode_cost_ratio; issue 16's goal: at most 2x)",
+                subcode_cost);
+  report.notes.push_back(line);
   report.notes.push_back(
       std::string("pair kernel: ") + detail::kernel_isa_name(detail::best_kernel_isa()) +
       "; distorted camera (k1 -0.1, k2 0.05) RMS " + std::to_string(1e3 * distorted.rms_error_m) +

@@ -1,13 +1,18 @@
 // Stand-alone runner for the decode benchmark (the same function `avs bench decode` runs), for
-// building without the whole avs program: prints the report rows and the JSON keys.
+// building without the whole avs program: prints the report rows and the JSON keys (always, so
+// --json is accepted and ignored).
+#include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <string>
 #include <vector>
 
 #include "avs/bench/report.hpp"
 
-int main(int argc, char** argv) {
-  const std::vector<std::string> args(argv + 1, argv + argc);
+namespace {
+
+int run(std::vector<std::string> args) {
+  args.erase(std::remove(args.begin(), args.end(), "--json"), args.end());
   for (const auto& bench : avs::bench::bench_registry()) {
     if (bench.name != "decode") continue;
     const avs::bench::Report report = bench.run(args);
@@ -32,4 +37,18 @@ int main(int argc, char** argv) {
   }
   std::fprintf(stderr, "decode benchmark not registered\n");
   return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(std::vector<std::string>(argv + 1, argv + argc));
+  } catch (const avs::bench::HelpRequested& help) {
+    std::printf("%s\n", help.what());
+    return 0;
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "avs_decode_bench_run: %s\n", error.what());
+    return 2;
+  }
 }
