@@ -68,7 +68,10 @@ Status write_tail(OutputFile& file, const TailContent& content, bool data_sectio
     for (const auto& [id, channel] : *content.channels) put_channel_record(buffer, channel);
   });
   add_group(Opcode::chunk_index, [&] {
-    for (const ChunkIndex& index : *content.chunk_indexes) put_chunk_index_record(buffer, index);
+    if (content.chunk_index_records != nullptr) buffer.append(content.chunk_index_records->span());
+    if (content.chunk_indexes != nullptr) {
+      for (const ChunkIndex& index : *content.chunk_indexes) put_chunk_index_record(buffer, index);
+    }
   });
   add_group(Opcode::statistics, [&] { put_statistics_record(buffer, content.statistics); });
   add_group(Opcode::metadata_index, [&] {

@@ -34,6 +34,8 @@ struct TailContent {
   const std::vector<ChunkIndex>* chunk_indexes = nullptr;
   const std::vector<MetadataIndex>* metadata_indexes = nullptr;
   Statistics statistics;
+  /// Chunk Index records already serialized (Writer), written before any `chunk_indexes`.
+  const ByteBuffer* chunk_index_records = nullptr;
 };
 
 /// Writes Data End (CRC = file.crc() when `data_section_crc`), the summary, Summary Offsets,

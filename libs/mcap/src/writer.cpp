@@ -60,7 +60,12 @@ struct Writer::Impl {
   std::uint64_t message_bytes = 0;
 
   // Output-stage state (read by the caller only after the worker is joined).
-  std::vector<ChunkIndex> chunk_indexes;
+  // The summary's Chunk Index records, serialized as each chunk is written: a recording keeps
+  // one per chunk until close(), so they are kept as the ~120 bytes they take in the file
+  // rather than as ChunkIndex structs with a map (~480 bytes with four channels;
+  // tests/mcap/mcap_writer_memory_test.cpp).
+  ByteBuffer chunk_index_records;
+  std::uint32_t chunk_index_count = 0;
   std::vector<MetadataIndex> metadata_indexes;
   std::atomic<std::uint64_t> chunks_written{0};
   std::atomic<std::uint64_t> bytes_written{0};
@@ -144,7 +149,8 @@ struct Writer::Impl {
     // Every finished chunk reaches the kernel now: a killed recorder loses at most the chunk
     // being filled (docs/bag.md, repair), never staged records of earlier ones.
     if (Status s = file.flush(); !s.ok()) return s;
-    chunk_indexes.push_back(std::move(index));
+    detail::put_chunk_index_record(chunk_index_records, index);
+    ++chunk_index_count;
     chunks_written.fetch_add(1);
     messages_in_file.fetch_add(job.message_count);
     {
@@ -418,8 +424,9 @@ Status Writer::close() {
     Statistics stats = m.statistics;
     stats.schema_count = static_cast<std::uint16_t>(m.schemas.size());
     stats.channel_count = static_cast<std::uint32_t>(m.channels.size());
-    stats.chunk_count = static_cast<std::uint32_t>(m.chunk_indexes.size());
-    detail::TailContent tail{&m.schemas, &m.channels, &m.chunk_indexes, &m.metadata_indexes, stats};
+    stats.chunk_count = m.chunk_index_count;
+    detail::TailContent tail{&m.schemas, &m.channels, nullptr, &m.metadata_indexes, stats};
+    tail.chunk_index_records = &m.chunk_index_records;
     status = detail::write_tail(m.file, tail, m.options.data_section_crc, m.options.summary_crc);
   }
   Status closed = m.file.close();
