@@ -159,16 +159,26 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
   std::mt19937 random(11);
   int narrow_runs = 0;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  for (const auto& [width, height] : {std::pair{37, 90}, std::pair{16, 7}}) {
+  // Codes of a few hundred, then (largest < 0) codes up to the largest the 16-bit sums of that
+  // half window allow, (h + 1)^2 x largest < 2^15, so that those sums come near their limits.
+  struct Field {
+    int width, height, half;
+  };
+  for (const Field field : {Field{37, 90, 0}, Field{16, 7, 0}, Field{46, 60, 0}, Field{37, 60, 1},
+                            Field{37, 60, 4}, Field{46, 60, 7}, Field{37, 60, 16}}) {
+    const int width = field.width;
+    const int height = field.height;
+    const int largest = field.half > 0 ? 32767 / ((field.half + 1) * (field.half + 1)) : 0;
     std::vector<std::int16_t> codes(static_cast<std::size_t>(width) * height);
     for (int x = 0; x < width; ++x) {
-      double f = 40.0 + 3.0 * x;
+      double f = largest > 0 ? largest - 60.0 + x : 40.0 + 3.0 * x;
       const double slope = 0.1 + 0.9 * unit(random);
       for (int y = 0; y < height; ++y) {
         f += slope + (unit(random) < 0.03 ? 30.0 * (unit(random) - 0.5) : 0.0);
         const double noisy = f + 0.4 * (unit(random) - 0.5);
         codes[static_cast<std::size_t>(y) * width + x] =
-            unit(random) < 0.12 ? std::int16_t{-1} : quantise(std::max(noisy, 0.0));
+            unit(random) < 0.12 ? std::int16_t{-1}
+                                : quantise(std::clamp(noisy, 0.0, largest > 0 ? largest : 32767.0));
       }
     }
     // With the largest code known the AVX2 step takes 16-bit sums where they are exact (half
@@ -179,13 +189,18 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
       configurations.emplace_back(KernelIsa::kAvx2, 0);
       configurations.emplace_back(KernelIsa::kAvx2, code_count);
     }
-    for (const int half : {1, 2, 4, 7, 16}) {
-      for (const int max_jump : {0, 2, 5}) {
+    int field_narrow_runs = 0;
+    const std::vector<int> halves =
+        field.half > 0 ? std::vector<int>{field.half} : std::vector<int>{1, 2, 4, 7, 16};
+    for (const int half : halves) {
+      // 40000 and 65536: beyond the 16-bit factors of the AVX2 steps' products (clamped).
+      for (const int max_jump : {0, 2, 5, 40000, 65536}) {
         const std::vector<float> expected =
             refine_by_definition(codes, width, height, half, max_jump);
         for (const auto& [isa, code_count] : configurations) {
           SubcodeRefiner refiner({width, height, half, max_jump, code_count}, isa);
           narrow_runs += refiner.narrow_sums() ? 1 : 0;
+          field_narrow_runs += refiner.narrow_sums() ? 1 : 0;
           std::vector<float> refined(codes.size());
           refiner.refine(codes.data(), refined.data());
           int refined_pixels = 0;
@@ -196,10 +211,14 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
             EXPECT_GT(refined_pixels, 0) << "half " << half;
           }
           ASSERT_EQ(std::memcmp(refined.data(), expected.data(), refined.size() * sizeof(float)), 0)
-              << kernel_isa_name(isa) << ", largest code " << code_count - 1 << ", " << width << "x"
+              << kernel_isa_name(isa) << ", code count " << code_count << ", " << width << "x"
               << height << ", half window " << half << ", max jump " << max_jump;
         }
       }
+    }
+    if (field.half > 0 && best_kernel_isa() == KernelIsa::kAvx2) {
+      EXPECT_GT(field_narrow_runs, 0) << "codes up to " << largest << " with half window "
+                                      << field.half << " take the 16-bit sums";
     }
   }
   EXPECT_GT(narrow_runs, 0) << "the 16-bit sums were compared too";

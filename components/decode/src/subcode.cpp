@@ -17,6 +17,10 @@ SubcodeRefiner::SubcodeRefiner(SubcodeParams params, KernelIsa isa) : params_(pa
         "sub-code refinement: half window " + std::to_string(params_.half_window) +
         " outside 1..16 or max jump " + std::to_string(params_.max_jump) + " negative");
   }
+  // A code changes by at most 32767 (codes are int16), so a larger max_jump flags nothing more
+  // than 32767 does: clamped, max_jump x gap stays within int32 in the plain step and within the
+  // 16-bit factors of the AVX2 steps' products (vpmaddwd, vpmullw).
+  params_.max_jump = std::min(params_.max_jump, 32767);
   const auto w = static_cast<std::size_t>(params_.width);
   // The 16-bit sums are exact (wrapping arithmetic, exact at every output) when the largest sums
   // fit: sc <= (2h + 1) c, |scd| and the leaving row's term within (h + 1)^2 c for c = the largest
@@ -275,7 +279,7 @@ AVS_AVX2_INLINE __m256i add8(Window8& w, __m256i c, __m256i y_in, __m256i d_in, 
 
 // The mean sc / n of complete windows (n = 2h + 1) as sc * (1 / n) in double, rounded once to
 // float. That is the float division sc / n bit for bit: sc and n are exact, n is odd, so sc / n
-// is never within 2^-30 (relative) of a float rounding midpoint, and the double product is
+// is never within about 2^-30 (relative) of a float rounding midpoint, and the double product is
 // within 2^-52 of it (an exhaustive check in tests/decode/subcode_test.cpp). No division.
 AVS_AVX2_INLINE __m256 mean8(__m256i sc, const WindowConstants8& k) {
   const __m128 low = _mm256_cvtpd_ps(

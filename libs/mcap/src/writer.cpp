@@ -61,7 +61,7 @@ struct Writer::Impl {
 
   // Output-stage state (read by the caller only after the worker is joined).
   // The summary's Chunk Index records, serialized as each chunk is written: a recording keeps
-  // one per chunk until close(), so they are kept as the ~120 bytes they take in the file
+  // one per chunk until close(), so they are kept as the ~117 bytes they take in the file
   // rather than as ChunkIndex structs with a map (~480 bytes with four channels;
   // tests/mcap/mcap_writer_memory_test.cpp).
   ByteBuffer chunk_index_records;
