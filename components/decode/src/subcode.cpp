@@ -191,12 +191,6 @@ AVS_AVX2_INLINE __m128i pack16(__m256i v) {
   return _mm_packs_epi32(_mm256_castsi256_si128(v), _mm256_extracti128_si256(v, 1));
 }
 
-// a * b per 32-bit lane for a and b within int16 (the upper half of each lane of `a` zero or a's
-// sign, of `b` zero): one vpmaddwd, where vpmulld costs two micro-ops on some cores.
-AVS_AVX2_INLINE __m256i multiply16(__m256i a, __m256i b) {
-  return _mm256_madd_epi16(a, b);
-}
-
 // The window's sums of 8 columns, and the steps of the plain loop on them one for one (exact
 // integers, then the one float division), so that both give bit-identical codes
 // (tests/decode/subcode_test.cpp). Products of small factors (a code and a row offset, max_jump
@@ -360,9 +354,7 @@ __attribute__((target("avx2"))) void window_step_avx2(const StepArgs& a) {
   }
   window_step_plain<kAdd, kRemove, kOutput>(a, x);
 }
-#endif
 
-#if defined(__x86_64__) && defined(__GNUC__)
 AVS_AVX2_INLINE __m256i word(int v) {
   return _mm256_set1_epi16(static_cast<short>(v));
 }
@@ -403,12 +395,12 @@ __attribute__((target("avx2"))) void window_step_avx2_narrow(const StepArgs& a) 
   for (; x + 16 <= a.width; x += 16) {
     __m256i n = load(s.n + x), sd = load(s.sd + x), sdd = load(s.sdd + x), sc = load(s.sc + x),
             scd = load(s.scd + x), jumps = load(s.jumps + x);
-    if constexpr (kOutput) {  // shift8
+    if constexpr (kOutput) {  // as shift8
       sdd = _mm256_sub_epi16(_mm256_add_epi16(sdd, n), _mm256_slli_epi16(sd, 1));
       sd = _mm256_sub_epi16(sd, n);
       scd = _mm256_sub_epi16(scd, sc);
     }
-    if constexpr (kRemove) {  // remove8
+    if constexpr (kRemove) {  // as remove8
       const __m256i c = load(a.leaving + x);
       const __m256i valid = _mm256_cmpgt_epi16(c, minus_one);
       const __m256i vc = _mm256_and_si256(valid, c);
@@ -420,7 +412,7 @@ __attribute__((target("avx2"))) void window_step_avx2_narrow(const StepArgs& a) 
       jumps = _mm256_sub_epi16(jumps, _mm256_cvtepu8_epi16(_mm_loadu_si128(
                                           reinterpret_cast<const __m128i*>(a.leaving_jump + x))));
     }
-    if constexpr (kAdd) {  // add8
+    if constexpr (kAdd) {  // as add8
       const __m256i c = load(a.entering + x);
       const __m256i valid = _mm256_cmpgt_epi16(c, minus_one);
       const __m256i previous = load(a.previous + x);

@@ -80,7 +80,8 @@ Status repair_file(const std::filesystem::path& input, const std::filesystem::pa
   detail::end_record(buffer, at);
   if (Status s = file.write(buffer); !s.ok()) return s;
 
-  std::vector<ChunkIndex> chunk_indexes;
+  detail::ByteBuffer chunk_index_records;  // the summary's Chunk Index records, as written
+  std::uint32_t chunk_count = 0;
   std::vector<MetadataIndex> metadata_indexes;
   Statistics stats;
   auto copy_record = [&](const detail::RecordView& record) {
@@ -116,7 +117,8 @@ Status repair_file(const std::filesystem::path& input, const std::filesystem::pa
         for (const auto& entry : entries) count_message(stats, channel, entry.first);
         report.messages_kept += entries.size();
       }
-      chunk_indexes.push_back(std::move(index));
+      detail::put_chunk_index_record(chunk_index_records, index);
+      ++chunk_count;
       ++report.chunks_kept;
     } else if (op == Opcode::message) {
       detail::MessageFields fields;
@@ -159,8 +161,8 @@ Status repair_file(const std::filesystem::path& input, const std::filesystem::pa
     stats.channel_message_counts.try_emplace(id, 0);
   stats.schema_count = static_cast<std::uint16_t>(scanner.schemas().size());
   stats.channel_count = static_cast<std::uint32_t>(scanner.channels().size());
-  stats.chunk_count = static_cast<std::uint32_t>(chunk_indexes.size());
-  detail::TailContent tail{&scanner.schemas(), &scanner.channels(), &chunk_indexes,
+  stats.chunk_count = chunk_count;
+  detail::TailContent tail{&scanner.schemas(), &scanner.channels(), &chunk_index_records,
                            &metadata_indexes, stats};
   Status written = detail::write_tail(file, tail, true, true);
   Status closed = file.close();

@@ -67,12 +67,7 @@ Status write_tail(OutputFile& file, const TailContent& content, bool data_sectio
   add_group(Opcode::channel, [&] {
     for (const auto& [id, channel] : *content.channels) put_channel_record(buffer, channel);
   });
-  add_group(Opcode::chunk_index, [&] {
-    if (content.chunk_index_records != nullptr) buffer.append(content.chunk_index_records->span());
-    if (content.chunk_indexes != nullptr) {
-      for (const ChunkIndex& index : *content.chunk_indexes) put_chunk_index_record(buffer, index);
-    }
-  });
+  add_group(Opcode::chunk_index, [&] { buffer.append(content.chunk_index_records->span()); });
   add_group(Opcode::statistics, [&] { put_statistics_record(buffer, content.statistics); });
   add_group(Opcode::metadata_index, [&] {
     for (const MetadataIndex& index : *content.metadata_indexes) {

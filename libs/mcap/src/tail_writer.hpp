@@ -31,11 +31,11 @@ void put_chunk_header(ByteBuffer& out, Timestamp start, Timestamp end,
 struct TailContent {
   const std::map<SchemaId, Schema>* schemas = nullptr;
   const std::map<ChannelId, Channel>* channels = nullptr;
-  const std::vector<ChunkIndex>* chunk_indexes = nullptr;
+  /// The Chunk Index records, serialized as each chunk was written (a recording keeps one per
+  /// chunk until the end: as bytes they take a third of the memory of ChunkIndex structs).
+  const ByteBuffer* chunk_index_records = nullptr;
   const std::vector<MetadataIndex>* metadata_indexes = nullptr;
   Statistics statistics;
-  /// Chunk Index records already serialized (Writer), written before any `chunk_indexes`.
-  const ByteBuffer* chunk_index_records = nullptr;
 };
 
 /// Writes Data End (CRC = file.crc() when `data_section_crc`), the summary, Summary Offsets,

@@ -425,8 +425,8 @@ Status Writer::close() {
     stats.schema_count = static_cast<std::uint16_t>(m.schemas.size());
     stats.channel_count = static_cast<std::uint32_t>(m.channels.size());
     stats.chunk_count = m.chunk_index_count;
-    detail::TailContent tail{&m.schemas, &m.channels, nullptr, &m.metadata_indexes, stats};
-    tail.chunk_index_records = &m.chunk_index_records;
+    detail::TailContent tail{&m.schemas, &m.channels, &m.chunk_index_records, &m.metadata_indexes,
+                             stats};
     status = detail::write_tail(m.file, tail, m.options.data_section_crc, m.options.summary_crc);
   }
   Status closed = m.file.close();
