@@ -25,6 +25,7 @@
 #include "avs/msg/type_registry.hpp"
 #include "avs/runtime/raw_topic.hpp"
 #include "avs/testing/cpu_hog.hpp"
+#include "avs/testing/scratch_dir.hpp"
 #include "bag_process.hpp"
 #include "rosgraph_msgs.h"
 #include "std_msgs.h"
@@ -36,12 +37,8 @@ using namespace std::chrono_literals;
 namespace fs = std::filesystem;
 
 fs::path temp_dir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("avs_bag_test_" + std::to_string(getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
+  static const avs::testing::ScratchDir dir("avs_bag_test_");
+  return dir.path();
 }
 
 std::string talker_graph() {

@@ -5,12 +5,11 @@
 #include <fstream>
 #include <string>
 
-#include <unistd.h>
-
 #include <gtest/gtest.h>
 
 #include "avs/geometry/mesh.hpp"
 #include "avs/geometry/primitives.hpp"
+#include "avs/testing/scratch_dir.hpp"
 
 namespace avs::geometry {
 namespace {
@@ -18,9 +17,7 @@ namespace {
 class MeshIoTest : public ::testing::Test {
  protected:
   std::string path(const std::string& name) const {
-    const auto dir =
-        std::filesystem::temp_directory_path() / ("avs_mesh_io_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    static const avs::testing::ScratchDir dir("avs_mesh_io_");
     return (dir / name).string();
   }
   std::string write(const std::string& name, const std::string& text) const {
