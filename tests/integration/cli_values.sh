@@ -59,6 +59,20 @@ if "$avs" bench 2>/dev/null | grep -q '^servo'; then
   refused "avs bench matching: --poses wants an integer in [1, 100000], got 'nan'" bench matching --poses nan
   refused "avs bench bag: --duration wants a number in [0.1, 3600], got '-1'" bench bag --duration=-1
   refused "avs bench servo: unknown option --sconds" bench servo --sconds=3
+  refused "avs bench servo: --sched-fifo wants an integer in [0, 99], got '100'" bench servo --sched-fifo 100
+  # The policy the servo bench ran under is the one reported: SCHED_FIFO where this process may
+  # set it, else one line saying it was refused and the figures are SCHED_OTHER's.
+  err=$(mktemp)
+  json=$(timeout 30 "$avs" bench servo --seconds 0.1 --sched-fifo 10 --json 2>"$err") ||
+    fail "avs bench servo --sched-fifo 10 failed: $(cat "$err")"
+  if chrt -f 10 true 2>/dev/null; then
+    grep -qF '"sched_fifo_priority": 10' <<<"$json" || fail "--sched-fifo 10 not in force: $json"
+  else
+    grep -qF '"sched_fifo_priority": 0' <<<"$json" || fail "--sched-fifo refused yet: $json"
+    grep -q "not permitted" "$err" || fail "--sched-fifo refused without a word: $(cat "$err")"
+  fi
+  rm -f "$err"
+  echo "ok: avs bench servo --sched-fifo reports the policy in force"
   # `avs bench NAME --help` is the benchmark's help, not `avs bench`'s, and runs nothing.
   help=$(timeout 10 "$avs" bench servo --help) || fail "avs bench servo --help failed"
   grep -qF -- "--seconds N                 a number in [0.1, 3600] (default 3)" <<<"$help" ||
