@@ -54,23 +54,26 @@ struct LocalSubscription {
   std::shared_ptr<SubscriptionBacklog> backlog;
 };
 
-/// Queues `sample` for `sub` on its lane (the one path of local and DDS-received samples).
-void post_sample(Scheduler& scheduler, const LocalSubscription& sub,
-                 std::shared_ptr<const void> sample) {
-  if (sub.keep_last == 0) {
-    scheduler.post(sub.lane,
-                   [deliver = sub.deliver, sample = std::move(sample)] { deliver(sample); });
+/// Runs on the lane: hands `sample` to the subscription `context`, unless KEEP_LAST skips it.
+void deliver_sample(const void* context, const std::shared_ptr<const void>& sample,
+                    std::uint64_t sequence) {
+  const auto& sub = *static_cast<const LocalSubscription*>(context);
+  if (sub.keep_last > 0 &&
+      sub.backlog->posted.load(std::memory_order_relaxed) - sequence >= sub.keep_last) {
+    sub.backlog->skipped.fetch_add(1, std::memory_order_relaxed);
     return;
   }
-  const std::uint64_t seq = sub.backlog->posted.fetch_add(1, std::memory_order_relaxed) + 1;
-  scheduler.post(sub.lane, [deliver = sub.deliver, backlog = sub.backlog, keep = sub.keep_last, seq,
-                            sample = std::move(sample)] {
-    if (backlog->posted.load(std::memory_order_relaxed) - seq >= keep) {
-      backlog->skipped.fetch_add(1, std::memory_order_relaxed);
-      return;
-    }
-    deliver(sample);
-  });
+  sub.deliver(sample);
+}
+
+/// Queues `sample` for `sub` on its lane (the one path of local and DDS-received samples),
+/// without an allocation (Scheduler::post with a function pointer). `sub` lives as long as the
+/// container: subscriptions are made before it runs and never removed.
+void post_sample(Scheduler& scheduler, const LocalSubscription& sub,
+                 std::shared_ptr<const void> sample) {
+  const std::uint64_t sequence =
+      sub.keep_last == 0 ? 0 : sub.backlog->posted.fetch_add(1, std::memory_order_relaxed) + 1;
+  scheduler.post(sub.lane, &deliver_sample, &sub, std::move(sample), sequence);
 }
 
 /// Everything the container knows about one DDS topic.
@@ -301,19 +304,22 @@ class ComponentHost final : public ComponentContext, public ParameterNode {
                                                              const std::string& dds_type,
                                                              bool publishing) const;
 
-  /// Runs `fn` only while active; an exception fails the container with context.
+  /// Runs `fn` now, only while active; an exception fails the container with context.
+  template <class F>
+  void run_guarded(F&& fn) {
+    if (!active_) return;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      fn();
+      record_callback(std::chrono::steady_clock::now() - start);
+    } catch (const std::exception& e) {
+      container_.fail("component '" + instance_.name + "' (" + instance_.type +
+                      "): callback failed: " + e.what());
+    }
+  }
+  /// run_guarded as a callback to keep (timers).
   std::function<void()> guard(std::function<void()> fn) {
-    return [this, fn = std::move(fn)] {
-      if (!active_) return;
-      const auto start = std::chrono::steady_clock::now();
-      try {
-        fn();
-        record_callback(std::chrono::steady_clock::now() - start);
-      } catch (const std::exception& e) {
-        container_.fail("component '" + instance_.name + "' (" + instance_.type +
-                        "): callback failed: " + e.what());
-      }
-    };
+    return [this, fn = std::move(fn)] { run_guarded(fn); };
   }
 
  public:
@@ -466,7 +472,7 @@ TopicEntry& ComponentHost::add_subscription(
   subscribed.push_back(&topic);
   LocalSubscription sub{lane_,
                         [this, cb = std::move(callback)](std::shared_ptr<const void> sample) {
-                          guard([&] { cb(std::move(sample)); })();
+                          run_guarded([&] { cb(std::move(sample)); });
                         }};
   // Only where the clock does not wait for the component (wall time, or simulated time paced
   // at a real-time factor) can its input outrun it; in lockstep skipping would also make the

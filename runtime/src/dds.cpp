@@ -49,9 +49,9 @@ void Participant::apply_partition(dds_qos_t* qos) const {
 
 Topic::Topic(const Participant& participant, const dds_topic_descriptor_t* descriptor,
              const std::string& name, const QosProfile& qos)
-    : Entity(check_dds(dds_create_topic(participant.get(), descriptor, name.c_str(),
-                                        Qos(qos).get(), nullptr),
-                       "create topic " + name + " (" + descriptor->m_typename + ")")),
+    : Entity(check_dds(
+          dds_create_topic(participant.get(), descriptor, name.c_str(), Qos(qos).get(), nullptr),
+          "create topic " + name + " (" + descriptor->m_typename + ")")),
       name_(name) {}
 
 namespace {
@@ -70,11 +70,17 @@ Writer::Writer(const Participant& participant, const Topic& topic, const QosProf
                        "create writer on " + topic.name())),
       topic_name_(topic.name()) {}
 
-void Writer::write(const void* sample) { check_dds(dds_write(get(), sample), "write to " + topic_name_); }
+// The error's context is built only on failure: these run per sample, where a message string
+// made every time was a heap allocation per frame (issue 16 section 3).
+void Writer::write(const void* sample) {
+  const dds_return_t rc = dds_write(get(), sample);
+  if (rc < 0) check_dds(rc, "write to " + topic_name_);
+}
 
 std::uint32_t Writer::matched_readers() const {
   dds_publication_matched_status_t status{};
-  check_dds(dds_get_publication_matched_status(get(), &status), "matched status of " + topic_name_);
+  const dds_return_t rc = dds_get_publication_matched_status(get(), &status);
+  if (rc < 0) check_dds(rc, "matched status of " + topic_name_);
   return status.current_count;
 }
 
@@ -105,6 +111,8 @@ int WaitSet::wait(dds_attach_t* triggered, std::size_t capacity, dds_duration_t 
   return n;
 }
 
-void WaitSet::wake() { check_dds(dds_set_guardcondition(guard_.get(), true), "wake waitset"); }
+void WaitSet::wake() {
+  check_dds(dds_set_guardcondition(guard_.get(), true), "wake waitset");
+}
 
 }  // namespace avs::runtime::dds

@@ -3,9 +3,46 @@
 #include <algorithm>
 #include <chrono>
 
+#include <boost/circular_buffer.hpp>
+
 #include "avs/runtime/error.hpp"
 
 namespace avs::runtime {
+
+/// One queued piece of work: a callback, or a sample delivery (function pointer, context and
+/// sample: moved in and out of the queue without an allocation).
+struct Scheduler::Lane {
+  struct Task {
+    Callback callback;
+    DeliverFn deliver = nullptr;
+    const void* context = nullptr;
+    std::shared_ptr<const void> sample;
+    std::uint64_t sequence = 0;
+
+    void run() const {
+      if (deliver != nullptr) {
+        deliver(context, sample, sequence);
+      } else {
+        callback();
+      }
+    }
+  };
+
+  /// FIFO whose storage only grows (doubling when full): after warm-up a post allocates
+  /// nothing, where a std::deque allocates and frees a block every few elements.
+  boost::circular_buffer<Task> queue{64};
+  bool idle = false;
+
+  void push(Task task) {
+    if (queue.full()) queue.set_capacity(2 * queue.capacity());
+    queue.push_back(std::move(task));
+  }
+  Task pop() {
+    Task task = std::move(queue.front());
+    queue.pop_front();
+    return task;
+  }
+};
 
 namespace {
 std::int64_t steady_ns() {
@@ -27,16 +64,34 @@ Scheduler::Scheduler(TimeMode mode, double real_time_factor)
   }
 }
 
+Scheduler::~Scheduler() = default;
+
 int Scheduler::add_lane() {
   std::lock_guard lock(mutex_);
-  lanes_.emplace_back();
+  lanes_.push_back(std::make_unique<Lane>());
   return static_cast<int>(lanes_.size()) - 1;
 }
 
 void Scheduler::post(int lane, Callback fn) {
+  Lane::Task task;
+  task.callback = std::move(fn);
   {
     std::lock_guard lock(mutex_);
-    lanes_.at(static_cast<std::size_t>(lane)).queue.push_back(std::move(fn));
+    lanes_.at(static_cast<std::size_t>(lane))->push(std::move(task));
+  }
+  changed_.notify_all();
+}
+
+void Scheduler::post(int lane, DeliverFn deliver, const void* context,
+                     std::shared_ptr<const void> sample, std::uint64_t sequence) {
+  Lane::Task task;
+  task.deliver = deliver;
+  task.context = context;
+  task.sample = std::move(sample);
+  task.sequence = sequence;
+  {
+    std::lock_guard lock(mutex_);
+    lanes_.at(static_cast<std::size_t>(lane))->push(std::move(task));
   }
   changed_.notify_all();
 }
@@ -48,7 +103,8 @@ std::uint64_t Scheduler::add_timer(int lane, Duration period, Callback fn) {
     std::lock_guard lock(mutex_);
     id = next_timer_id_++;
     const std::int64_t deadline = (now_locked() + period).ns;
-    timers_.emplace(TimerKey{deadline, id}, Timer{lane, period, std::move(fn)});
+    timers_.emplace(TimerKey{deadline, id},
+                    Timer{lane, period, std::make_shared<const Callback>(std::move(fn))});
     timer_deadlines_[id] = deadline;
   }
   changed_.notify_all();
@@ -122,14 +178,14 @@ std::optional<Scheduler::TimerKey> Scheduler::next_timer_locked(int lane) const 
 
 bool Scheduler::all_idle_locked() const {
   for (const auto& lane : lanes_) {
-    if (!lane.idle || !lane.queue.empty()) return false;
+    if (!lane->idle || !lane->queue.empty()) return false;
   }
   return timers_.empty() || timers_.begin()->first.first > sim_now_.ns;
 }
 
 void Scheduler::run_lane(int lane_index) {
   std::unique_lock lock(mutex_);
-  Lane& lane = lanes_.at(static_cast<std::size_t>(lane_index));
+  Lane& lane = *lanes_.at(static_cast<std::size_t>(lane_index));
   while (!stopping_) {
     if (end_ && now_locked() >= *end_) {
       stopping_ = true;
@@ -137,30 +193,34 @@ void Scheduler::run_lane(int lane_index) {
       break;
     }
     if (!lane.queue.empty()) {
-      Callback fn = std::move(lane.queue.front());
-      lane.queue.pop_front();
-      lock.unlock();
-      fn();
+      {
+        const Lane::Task task = lane.pop();
+        lock.unlock();
+        task.run();
+      }  // the task and its sample released before the lock is taken again
       lock.lock();
       continue;
     }
     const auto next = next_timer_locked(lane_index);
     const Time now = now_locked();
     if (next && next->first <= now.ns) {
+      // The timer's node re-keyed and put back: no allocation per tick.
       auto node = timers_.extract(*next);
-      Timer& timer = node.mapped();
+      const Timer& timer = node.mapped();
       // Next deadline on the period grid; in wall time, skip slots already missed.
       std::int64_t deadline = next->first + timer.period.count();
       if (deadline <= now.ns && mode_ != TimeMode::sim_lockstep) {
         const std::int64_t missed = (now.ns - deadline) / timer.period.count() + 1;
         deadline += missed * timer.period.count();
       }
-      Callback fn = timer.fn;  // copy: the timer may be cancelled while fn runs
+      // A reference, not a copy of the function: the timer may be cancelled while fn runs.
+      const std::shared_ptr<const Callback> fn = timer.fn;
       const std::uint64_t id = next->second;
-      timers_.emplace(TimerKey{deadline, id}, std::move(timer));
+      node.key() = TimerKey{deadline, id};
+      timers_.insert(std::move(node));
       timer_deadlines_[id] = deadline;
       lock.unlock();
-      fn();
+      (*fn)();
       lock.lock();
       continue;
     }
@@ -169,7 +229,7 @@ void Scheduler::run_lane(int lane_index) {
 }
 
 void Scheduler::wait_locked(std::unique_lock<std::mutex>& lock, int lane_index) {
-  Lane& lane = lanes_.at(static_cast<std::size_t>(lane_index));
+  Lane& lane = *lanes_.at(static_cast<std::size_t>(lane_index));
   lane.idle = true;
   const auto next = next_timer_locked(lane_index);
   switch (mode_) {
@@ -188,8 +248,8 @@ void Scheduler::wait_locked(std::unique_lock<std::mutex>& lock, int lane_index) 
       const std::int64_t target =
           next ? next->first : (now_locked() + std::chrono::milliseconds(1)).ns;
       const auto wake = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(
-          steady_start_ns_ + static_cast<std::int64_t>(static_cast<double>(target) /
-                                                       real_time_factor_)));
+          steady_start_ns_ +
+          static_cast<std::int64_t>(static_cast<double>(target) / real_time_factor_)));
       changed_.wait_until(lock, wake);
       const Time t = now_locked();
       if (time_advanced_) {

@@ -16,6 +16,8 @@
 
 #include <gtest/gtest.h>
 
+#include "allocation_counter.hpp"
+
 #include "avs/camera/pattern_sequencer.hpp"
 #include "avs/decode/rolling_decoder.hpp"
 #include "avs/matching/pipeline.hpp"
@@ -25,59 +27,10 @@
 #include "avs/tracking/moments.hpp"
 #include "avs/tracking/tracker.hpp"
 
-namespace {
-
-// Armed per thread: only the thread running the hot path counts (the servo test's simulated
-// amplifiers answer on a thread of their own).
-thread_local bool g_counting = false;
-std::atomic<long> g_allocations{0};
-
-void count() {
-  if (g_counting) g_allocations.fetch_add(1);
-}
-
-}  // namespace
-
-// Every heap allocation goes through malloc (operator new, std::vector, Eigen, nanoflann's
-// pool): glibc lets a program replace malloc, calloc, realloc and free (and uses them for
-// memalign & co.); these count and forward to glibc's own.
-extern "C" {
-void* __libc_malloc(std::size_t);
-void* __libc_calloc(std::size_t, std::size_t);
-void* __libc_realloc(void*, std::size_t);
-void __libc_free(void*);
-void* malloc(std::size_t size) {
-  count();
-  return __libc_malloc(size);
-}
-void* calloc(std::size_t n, std::size_t size) {
-  count();
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, std::size_t size) {
-  count();
-  return __libc_realloc(p, size);
-}
-void free(void* p) {
-  __libc_free(p);
-}
-}
-
 namespace avs {
 namespace {
 
-/// Counts the allocations made while it lives.
-class CountAllocations {
- public:
-  CountAllocations() {
-    g_allocations = 0;
-    g_counting = true;
-  }
-  ~CountAllocations() { g_counting = false; }
-  CountAllocations(const CountAllocations&) = delete;
-  CountAllocations& operator=(const CountAllocations&) = delete;
-  long count() const { return g_allocations.load(); }
-};
+using testing::CountAllocations;
 
 constexpr int kWarmUpFrames = 108;  // 6 cycles: every buffer has reached its working size
 constexpr int kCountedFrames = 1000;

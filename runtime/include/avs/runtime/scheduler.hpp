@@ -6,9 +6,9 @@
 
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <vector>
@@ -22,8 +22,12 @@ enum class TimeMode { wall, sim_follower, sim_lockstep, sim_realtime };
 class Scheduler {
  public:
   using Callback = std::function<void()>;
+  /// A sample delivery: called on the lane as deliver(context, sample, sequence).
+  using DeliverFn = void (*)(const void* context, const std::shared_ptr<const void>& sample,
+                             std::uint64_t sequence);
 
   explicit Scheduler(TimeMode mode, double real_time_factor = 1.0);
+  ~Scheduler();
   Scheduler(const Scheduler&) = delete;
   Scheduler& operator=(const Scheduler&) = delete;
 
@@ -32,6 +36,12 @@ class Scheduler {
 
   /// Queues `fn` on `lane`, FIFO. Thread-safe.
   void post(int lane, Callback fn);
+  /// Queues a sample delivery on `lane`, FIFO with the callbacks. Allocates nothing once the
+  /// lane's queue has grown to its working size (issue 16 section 3: a sample posted per frame
+  /// must not cost a heap allocation, as a lambda in a std::function does); `context` must
+  /// outlive the delivery.
+  void post(int lane, DeliverFn deliver, const void* context, std::shared_ptr<const void> sample,
+            std::uint64_t sequence);
 
   /// Calls `fn` on `lane` every `period`, first at now() + period. Thread-safe.
   std::uint64_t add_timer(int lane, Duration period, Callback fn);
@@ -65,12 +75,11 @@ class Scheduler {
   struct Timer {
     int lane;
     Duration period;
-    Callback fn;
+    /// Shared: the lane runs its own reference without a copy of the function, and a timer
+    /// cancelled while its callback runs keeps that callback alive until it returns.
+    std::shared_ptr<const Callback> fn;
   };
-  struct Lane {
-    std::deque<Callback> queue;
-    bool idle = false;
-  };
+  struct Lane;  // scheduler.cpp: a queue that keeps its storage
   using TimerKey = std::pair<std::int64_t, std::uint64_t>;  // (deadline ns, id)
 
   Time now_locked() const;
@@ -82,7 +91,7 @@ class Scheduler {
   const double real_time_factor_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::vector<Lane> lanes_;
+  std::vector<std::unique_ptr<Lane>> lanes_;
   std::map<TimerKey, Timer> timers_;
   std::map<std::uint64_t, std::int64_t> timer_deadlines_;  // id -> deadline, for cancel
   std::uint64_t next_timer_id_ = 1;
