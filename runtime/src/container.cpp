@@ -430,11 +430,9 @@ class LocalPublisher final : public PublisherCore {
  public:
   LocalPublisher(Scheduler& scheduler, TopicEntry& topic) : scheduler_(scheduler), topic_(topic) {}
 
-  void publish(std::shared_ptr<const void> sample) override {
-    for (const auto& sub : topic_.subscriptions) post_sample(scheduler_, sub, sample);
-    // Serialise only when a reader in another participant wants it, now or (latched) later.
-    topic_.tally.publish(*topic_.writer, sample.get(),
-                         topic_.latched || topic_.writer->matched_readers() > 0);
+  void publish(std::shared_ptr<const void> sample) override { publish(std::move(sample), false); }
+  void publish_unchanged(std::shared_ptr<const void> sample) override {
+    publish(std::move(sample), true);
   }
   const std::string& topic() const override { return topic_.dds_name; }
   std::size_t reader_count() const override {
@@ -442,6 +440,16 @@ class LocalPublisher final : public PublisherCore {
   }
 
  private:
+  void publish(std::shared_ptr<const void> sample, bool unchanged) {
+    for (const auto& sub : topic_.subscriptions) post_sample(scheduler_, sub, sample);
+    // Serialise only when a reader in another participant wants it, now or (latched) later;
+    // a latched copy equal to the one already in the history is not needed later.
+    topic_.tally.publish(
+        *topic_.writer, sample.get(),
+        (topic_.latched && !(unchanged && topic_.tally.cut().last_source_time_ns != 0)) ||
+            topic_.writer->matched_readers() > 0);
+  }
+
   Scheduler& scheduler_;
   TopicEntry& topic_;
 };

@@ -1,7 +1,9 @@
 // Issue 16 section 3, in a container: a sample published by one component and delivered to
 // another on the same lane (the intra-process path every frame takes: publish, the lane's queue,
-// the subscription's callback), and a timer's tick, allocate nothing after warm-up. The source
-// reuses one sample, as the components' sample pools do, so what is counted is the container's.
+// the subscription's callback), and a timer's tick, allocate nothing after warm-up (the source
+// reuses one sample, so what is counted is the container's); and the decode component's whole
+// callback per frame, fed rendered frames, allocates nothing either.
+#include <algorithm>
 #include <atomic>
 #include <memory>
 
@@ -11,12 +13,15 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/sample.hpp"
 #include "avs/testing/lockstep_graph.hpp"
+#include "ken_recording.hpp"
 
 namespace avs::testing {
 namespace {
 
 constexpr int kWarmUpTicks = 100;
 constexpr int kCountedTicks = 1000;
+constexpr int kWarmUpFrames = 108;  // 6 cycles: every buffer has reached its working size
+constexpr int kCountedFrames = 1000;
 
 /// Counting runs from the start of a tick to the end of the sink's callback for the sample the
 /// tick published: the timer, publish, the queue and the delivery, and nothing else the lane
@@ -81,6 +86,124 @@ class AllocSink final : public runtime::Component {
 AVS_REGISTER_COMPONENT(AllocSource);
 AVS_REGISTER_COMPONENT(AllocSink);
 
+/// The decode and tracking components' hot paths in their container: the recording's frames
+/// published on /camera/pattern (loaned samples, stamped 1 ms apart) with the head's joint
+/// states, and a marker behind each positive frame. Counting runs from the tick to the sink's
+/// delivery of the marker (a positive frame: decode's callback ran before it) or of the depth
+/// map (a negative frame: the sink comes after tracking in the graph, so decode's callback,
+/// and tracking's for that depth map, ran before it): the rolling update, sub-code refinement,
+/// moments and servo law, and every sample they fill and publish.
+class PatternSource final : public runtime::Component {
+ public:
+  static runtime::ComponentSpec spec() {
+    return {
+        .type = "test_alloc_pattern_source",
+        .description =
+            "publishes the rendered ken frames every 1 ms, each followed by a "
+            "marker that ends the allocation count",
+        .parameters = {},
+        .publishes = {runtime::port<msgs::avs_msgs::PatternFrame>("pattern", "/camera/pattern"),
+                      runtime::port<msgs::sensor_msgs::JointState>("joints", "/head/joint_states"),
+                      runtime::port<msgs::std_msgs::Float64>("marker", "alloc_marker")},
+        .subscribes = {}};
+  }
+  explicit PatternSource(runtime::ComponentContext& ctx)
+      : Component(ctx),
+        pattern_(ctx.publisher<msgs::avs_msgs::PatternFrame>("pattern")),
+        joints_(ctx.publisher<msgs::sensor_msgs::JointState>("joints")),
+        marker_(ctx.publisher<msgs::std_msgs::Float64>("marker")) {}
+  void on_activate() override {
+    timer_ = context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
+  }
+
+  long frames = 0;
+  long counted = -1;  ///< allocations over the counted frames (-1: not reached)
+
+ private:
+  void tick() {
+    if (frames == kWarmUpFrames) reset_counted_allocations();
+    if (frames == kWarmUpFrames + kCountedFrames) counted = counted_allocations();
+    count_allocations_on_this_thread(frames >= kWarmUpFrames &&
+                                     frames < kWarmUpFrames + kCountedFrames);
+    const decode::PatternFrame f = recording().frame(static_cast<int>(frames));
+    auto joints = joints_.loan();
+    runtime::to_ros_time(context().now(), joints->header.stamp);
+    runtime::resize_sequence(joints->name, 2);
+    runtime::resize_sequence(joints->position, 2);
+    runtime::resize_sequence(joints->velocity, 2);
+    runtime::set_string(joints->name._buffer[0], "pan");
+    runtime::set_string(joints->name._buffer[1], "tilt");
+    joints->position._buffer[0] = joints->position._buffer[1] = 0.0;
+    joints->velocity._buffer[0] = joints->velocity._buffer[1] = 0.0;
+    joints_.publish(std::move(joints));
+    auto m = pattern_.loan();
+    runtime::to_ros_time(context().now(), m->header.stamp);
+    runtime::set_string(m->header.frame_id, "camera_optical");
+    m->image.header.stamp = m->header.stamp;
+    runtime::set_string(m->image.header.frame_id, "camera_optical");
+    runtime::set_string(m->image.encoding, "mono8");
+    m->image.width = static_cast<std::uint32_t>(f.image.width);
+    m->image.height = static_cast<std::uint32_t>(f.image.height);
+    m->image.step = m->image.width;
+    m->image.is_bigendian = 0;
+    const auto bytes = static_cast<std::uint32_t>(f.image.width * f.image.height);
+    runtime::resize_sequence(m->image.data, bytes);
+    std::copy_n(f.image.data, bytes, m->image.data._buffer);
+    m->bit_index = static_cast<std::uint8_t>(f.bit_index);
+    m->bit_count = static_cast<std::uint8_t>(recording().per_cycle / 2);
+    m->positive = f.polarity == decode::Polarity::kPositive;
+    m->cycle = f.cycle;
+    m->pan_rad = m->tilt_rad = 0.0;
+    const bool positive = m->positive;
+    pattern_.publish(std::move(m));
+    if (positive) {
+      auto marker = marker_.loan();
+      marker->data = static_cast<double>(frames);
+      marker_.publish(std::move(marker));
+    }
+    ++frames;
+  }
+
+  runtime::Publisher<msgs::avs_msgs::PatternFrame> pattern_;
+  runtime::Publisher<msgs::sensor_msgs::JointState> joints_;
+  runtime::Publisher<msgs::std_msgs::Float64> marker_;
+  runtime::TimerId timer_{};
+};
+
+/// Ends the count at each marker and each depth map, and counts the depth maps and torque
+/// commands.
+class MarkerSink final : public runtime::Component {
+ public:
+  static runtime::ComponentSpec spec() {
+    return {.type = "test_alloc_marker_sink",
+            .description = "ends the allocation count at each marker; counts depth maps",
+            .parameters = {},
+            .publishes = {},
+            .subscribes = {runtime::port<msgs::std_msgs::Float64>("marker", "alloc_marker"),
+                           runtime::port<msgs::sensor_msgs::Image>("depth", "/depth/image"),
+                           runtime::port<msgs::avs_msgs::JointTorqueCommand>(
+                               "command", "/head/torque_command")}};
+  }
+  explicit MarkerSink(runtime::ComponentContext& ctx) : Component(ctx) {
+    ctx.subscribe<msgs::std_msgs::Float64>("marker",
+                                           [](runtime::SamplePtr<msgs::std_msgs::Float64>) {
+                                             count_allocations_on_this_thread(false);
+                                           });
+    ctx.subscribe<msgs::sensor_msgs::Image>("depth",
+                                            [this](runtime::SamplePtr<msgs::sensor_msgs::Image>) {
+                                              ++depth_maps;
+                                              count_allocations_on_this_thread(false);
+                                            });
+    ctx.subscribe<msgs::avs_msgs::JointTorqueCommand>(
+        "command", [this](runtime::SamplePtr<msgs::avs_msgs::JointTorqueCommand>) { ++commands; });
+  }
+  long depth_maps = 0;
+  long commands = 0;
+};
+
+AVS_REGISTER_COMPONENT(PatternSource);
+AVS_REGISTER_COMPONENT(MarkerSink);
+
 TEST(ContainerAllocations, PublishDeliverAndTimerTicksAllocateNothingAfterWarmUp) {
   const ContainerRun run = run_lockstep_container(
       {"{type: test_alloc_source, name: source}", "{type: test_alloc_sink, name: sink}"},
@@ -92,6 +215,25 @@ TEST(ContainerAllocations, PublishDeliverAndTimerTicksAllocateNothingAfterWarmUp
   EXPECT_GE(g_deliveries.load(), kWarmUpTicks + kCountedTicks);  // the path really ran
   EXPECT_EQ(source->counted, 0) << "allocations over " << kCountedTicks
                                 << " ticks, each a publish and a delivery";
+}
+
+TEST(ContainerAllocations, DecodeAndTrackingComponentsAllocateNothingPerFrameAfterWarmUp) {
+  const ContainerRun run = run_lockstep_container(
+      {"{type: test_alloc_pattern_source, name: source}",
+       "{type: decode, name: decode, parameters: {subcode_half_window: 4}}",
+       "{type: tracking, name: tracking}", "{type: test_alloc_marker_sink, name: sink}"},
+      (kWarmUpFrames + kCountedFrames + 20) * 1e-3);
+  ASSERT_EQ(run.status, 0) << (run.load_errors.empty() ? "" : run.load_errors.front());
+  const auto* source = run.find<PatternSource>("source");
+  const auto* sink = run.find<MarkerSink>("sink");
+  ASSERT_NE(source, nullptr);
+  ASSERT_NE(sink, nullptr);
+  ASSERT_GE(source->frames, kWarmUpFrames + kCountedFrames);
+  // Both really ran: a depth map per pair, a torque command per depth map.
+  EXPECT_GE(sink->depth_maps, (kWarmUpFrames + kCountedFrames) / 2 - 20);
+  EXPECT_GE(sink->commands, sink->depth_maps - 1);
+  EXPECT_EQ(source->counted, 0) << "allocations over " << kCountedFrames
+                                << " frames through the decode and tracking components";
 }
 
 }  // namespace

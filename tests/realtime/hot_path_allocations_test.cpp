@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "allocation_counter.hpp"
+#include "ken_recording.hpp"
 
 #include "avs/camera/pattern_sequencer.hpp"
 #include "avs/decode/rolling_decoder.hpp"
@@ -31,54 +32,10 @@ namespace avs {
 namespace {
 
 using testing::CountAllocations;
+using testing::recording;
 
 constexpr int kWarmUpFrames = 108;  // 6 cycles: every buffer has reached its working size
 constexpr int kCountedFrames = 1000;
-
-/// Two whole cycles of rendered frames of the ken on the manipulator trajectory, played
-/// forwards and backwards by cycle (as avs bench pipeline's pattern_replay).
-struct Recording {
-  sim::SimulatorConfig config;
-  std::vector<sim::SimFrame> frames;
-  int per_cycle = 18;
-
-  Recording() {
-    const matching::ObjectModel ken = matching::load_object_model("ken");
-    sim::Scene scene;
-    sim::SceneObject target;
-    target.name = "ken";
-    target.mesh = std::make_shared<const geometry::Mesh>(ken.mesh);
-    sim::ManipulatorMotionConfig motion;
-    target.trajectory = std::make_shared<sim::ManipulatorTrajectory>(motion);
-    scene.objects.push_back(target);
-    scene.objects.push_back(sim::make_background_plane(2.0));
-    sim::Simulator simulator(config, scene);
-    per_cycle = 2 * config.renderer.geometry.layout.bit_count;
-    for (int k = 0; k < 3 * per_cycle; ++k) {
-      frames.push_back(simulator.render(static_cast<std::uint64_t>(k), 0.5 + k * 1e-3, {}));
-    }
-  }
-
-  /// Frame k of the endless replay, its cycle counting up.
-  decode::PatternFrame frame(int k) const {
-    const int cycles = static_cast<int>(frames.size()) / per_cycle;
-    const int replay_cycle = k / per_cycle;
-    const int p = replay_cycle % (2 * (cycles - 1));
-    const int recorded = p < cycles ? p : 2 * (cycles - 1) - p;
-    const sim::SimFrame& f = frames[static_cast<std::size_t>(recorded * per_cycle + k % per_cycle)];
-    decode::PatternFrame input;
-    input.image = {f.image.pixels.data(), f.image.width, f.image.height, 0};
-    input.bit_index = f.pattern.bit_index;
-    input.polarity = f.pattern.positive ? decode::Polarity::kPositive : decode::Polarity::kNegative;
-    input.cycle = static_cast<std::uint32_t>(replay_cycle);
-    return input;
-  }
-};
-
-const Recording& recording() {
-  static const Recording r;
-  return r;
-}
 
 decode::DecoderConfig closed_loop_decoder() {
   decode::DecoderConfig c;

@@ -290,7 +290,7 @@ class DecodeComponent final : public runtime::Component {
     std::shared_ptr<msgs::sensor_msgs::Image> image;
     DecodeResult result;
     if (publishable) {
-      image = runtime::make_sample<msgs::sensor_msgs::Image>();
+      image = depth_.loan();
       runtime::resize_sequence(image->data, static_cast<std::uint32_t>(4 * width_ * height_));
       result =
           decoder_.push_frame(frame, std::span<float>(reinterpret_cast<float*>(image->data._buffer),
@@ -318,7 +318,7 @@ class DecodeComponent final : public runtime::Component {
     // information is effective_age_pairs pairs (2 frames each) plus half a frame (the pair's
     // mid-time) older than the newest frame (docs/decode.md).
     if (std::isfinite(result.effective_age_pairs) && frame_period_s_ > 0.0) {
-      auto info = runtime::make_sample<msgs::avs_msgs::DepthInfo>();
+      auto info = info_.loan();
       info->header.stamp = m.header.stamp;
       runtime::set_string(info->header.frame_id, frame_id_);
       info->effective_age_pairs = result.effective_age_pairs;
@@ -331,7 +331,7 @@ class DecodeComponent final : public runtime::Component {
 
     const double ms = pending_ms_ + ms_since(start);
     pending_ms_ = 0;
-    auto timing = runtime::make_sample<msgs::avs_msgs::StageTiming>();
+    auto timing = timing_.loan();
     timing->header.stamp = m.header.stamp;
     runtime::set_string(timing->header.frame_id, frame_id_);
     runtime::set_string(timing->stage, "decode");
@@ -370,19 +370,26 @@ class DecodeComponent final : public runtime::Component {
   }
 
   /// The camera model in force (the calibration's camera) as sensor_msgs/CameraInfo, with the
-  /// stamp of the depth image it goes with (none: zero, the latched copy at activation).
+  /// stamp of the depth image it goes with (none: zero, the latched copy at activation). The
+  /// model never changes while the component runs (retune keeps the geometry), so the copies
+  /// with an image are publish_unchanged: not serialised for the latched history when no
+  /// other process listens (no DDS allocation per depth map).
   void publish_camera_info(const msgs::builtin_interfaces::Time* stamp) {
-    auto info = runtime::make_sample<msgs::sensor_msgs::CameraInfo>();
+    auto info = camera_info_.loan();
     msg::to_camera_info(decoder_.config().geometry.camera, *info);
-    if (stamp != nullptr) info->header.stamp = *stamp;
+    info->header.stamp = stamp != nullptr ? *stamp : msgs::builtin_interfaces::Time{};
     runtime::set_string(info->header.frame_id, frame_id_);
-    camera_info_.publish(std::move(info));
+    if (stamp != nullptr) {
+      camera_info_.publish_unchanged(std::move(info));
+    } else {
+      camera_info_.publish(std::move(info));
+    }
   }
 
   /// Organised XYZ cloud (float32 x, y, z; NaN invalid) from the depth just computed:
   /// X = z x, Y = z y, Z = z with the undistorted ray (x, y, 1) of each pixel.
   void publish_points(const msgs::sensor_msgs::Image& depth_image) {
-    auto cloud = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
+    auto cloud = points_.loan();
     cloud->header.stamp = depth_image.header.stamp;
     runtime::set_string(cloud->header.frame_id, frame_id_);
     cloud->height = static_cast<std::uint32_t>(height_);

@@ -10,9 +10,15 @@ Eigen::Matrix3d CameraModel::intrinsic_matrix() const {
   return K;
 }
 
+std::size_t CameraModel::distortion_coefficients(std::array<double, 8>& out) const {
+  out = {k1, k2, p1, p2, k3, k4, k5, k6};
+  return is_rational() ? 8 : 5;
+}
+
 std::vector<double> CameraModel::distortion_coefficients() const {
-  if (is_rational()) return {k1, k2, p1, p2, k3, k4, k5, k6};
-  return {k1, k2, p1, p2, k3};
+  std::array<double, 8> d;
+  const std::size_t n = distortion_coefficients(d);
+  return {d.begin(), d.begin() + static_cast<std::ptrdiff_t>(n)};
 }
 
 bool CameraModel::set_distortion_coefficients(std::span<const double> d) {

@@ -269,7 +269,7 @@ class TrackingComponent final : public runtime::Component {
   }
 
   void publish_target(const msgs::sensor_msgs::Image& image, const TargetObservation& obs) {
-    auto msg = runtime::make_sample<msgs::avs_msgs::TargetObservation>();
+    auto msg = target_.loan();  // every field set below
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, runtime::get_string(image.header.frame_id));
     msg->m00 = obs.m00;
@@ -285,7 +285,7 @@ class TrackingComponent final : public runtime::Component {
   /// Wall-clock time of moments + servo law for this image (the "tracking" stage of reports).
   void publish_timing(const msgs::sensor_msgs::Image& image,
                       std::chrono::steady_clock::time_point started) {
-    auto msg = runtime::make_sample<msgs::avs_msgs::StageTiming>();
+    auto msg = timing_.loan();  // every field set below (frame_id stays empty)
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->stage, "tracking");
     msg->processing_ms =
@@ -295,7 +295,7 @@ class TrackingComponent final : public runtime::Component {
   }
 
   void publish_command(const Eigen::Vector2d& torque) {
-    auto msg = runtime::make_sample<msgs::avs_msgs::JointTorqueCommand>();
+    auto msg = command_.loan();  // every field set below
     // Stamped when computed: servo_drive's command timeout measures from here.
     runtime::to_ros_time(context().now(), msg->header.stamp);
     runtime::resize_sequence(msg->name, 2);

@@ -1,6 +1,7 @@
 #include "avs/msg/camera_info.hpp"
 
 #include <algorithm>
+#include <array>
 #include <span>
 
 #include "avs/runtime/sample.hpp"
@@ -11,9 +12,10 @@ void to_camera_info(const geometry::CameraModel& camera, msgs::sensor_msgs::Came
   out.width = static_cast<std::uint32_t>(camera.width);
   out.height = static_cast<std::uint32_t>(camera.height);
   runtime::set_string(out.distortion_model, camera.distortion_model());
-  const std::vector<double> d = camera.distortion_coefficients();
-  runtime::resize_sequence(out.d, static_cast<std::uint32_t>(d.size()));
-  std::copy(d.begin(), d.end(), out.d._buffer);
+  std::array<double, 8> d;
+  const std::size_t n = camera.distortion_coefficients(d);
+  runtime::resize_sequence(out.d, static_cast<std::uint32_t>(n));
+  std::copy_n(d.begin(), n, out.d._buffer);
   const double k[9] = {camera.fx_px, 0, camera.cx_px, 0, camera.fy_px, camera.cy_px, 0, 0, 1};
   std::copy(std::begin(k), std::end(k), out.k);
   const double r[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};

@@ -63,6 +63,8 @@ class PublisherCore {
  public:
   virtual ~PublisherCore() = default;
   virtual void publish(std::shared_ptr<const void> sample) = 0;
+  /// Publisher::publish_unchanged.
+  virtual void publish_unchanged(std::shared_ptr<const void> sample) { publish(std::move(sample)); }
   virtual const std::string& topic() const = 0;
   /// Readers now: subscriptions of this container's components plus matched readers of
   /// other participants (a source that must not start before its receiver is there).
@@ -75,14 +77,27 @@ template <class T>
 class Publisher {
  public:
   Publisher() = default;
-  explicit Publisher(std::shared_ptr<PublisherCore> core) : core_(std::move(core)) {}
+  explicit Publisher(std::shared_ptr<PublisherCore> core)
+      : core_(std::move(core)), pool_(std::make_shared<SamplePool<T>>()) {}
   void publish(std::shared_ptr<const T> sample) const { core_->publish(std::move(sample)); }
+  /// The same for a sample equal to the last one published but for its header's stamp (a
+  /// camera model sent with every image): on a latched (transient local) topic with no reader
+  /// in another process it is not serialised into the DDS history for nobody, which keeps the
+  /// earlier, equal copy for a late joiner; everyone matched gets it as with publish().
+  void publish_unchanged(std::shared_ptr<const T> sample) const {
+    core_->publish_unchanged(std::move(sample));
+  }
+  /// A sample to fill and publish, reused from an earlier message of this publisher once its
+  /// subscribers have let it go (SamplePool: no allocation per message once warm, as ROS 2's
+  /// loaned messages). It holds that message's values: set every field.
+  std::shared_ptr<T> loan() const { return pool_->acquire(); }
   const std::string& topic() const { return core_->topic(); }
   std::size_t reader_count() const { return core_->reader_count(); }
   explicit operator bool() const { return core_ != nullptr; }
 
  private:
   std::shared_ptr<PublisherCore> core_;
+  std::shared_ptr<SamplePool<T>> pool_;  ///< shared by copies of the publisher (one thread)
 };
 
 /// Publishing end for serialised samples (CDR, the 4-byte encapsulation header included) of
@@ -192,9 +207,7 @@ class Component {
   /// callbacks / callback_ms_* values), e.g. dropped inputs. Called by the container's
   /// diagnostics timer, possibly on another thread than the component's callbacks: guard
   /// the state it reads.
-  virtual std::vector<std::pair<std::string, std::string>> diagnostic_values() const {
-    return {};
-  }
+  virtual std::vector<std::pair<std::string, std::string>> diagnostic_values() const { return {}; }
 
   /// Dynamic parameters (ParamSpec::dynamic) changed while the graph runs (`avs param set`,
   /// ROS 2 set_parameters). Called on the component's thread between two of its callbacks,
@@ -236,8 +249,8 @@ class ComponentRegistry {
 
 template <class C>
 bool register_component() {
-  ComponentRegistry::instance().add(
-      C::spec(), [](ComponentContext& ctx) { return std::make_unique<C>(ctx); });
+  ComponentRegistry::instance().add(C::spec(),
+                                    [](ComponentContext& ctx) { return std::make_unique<C>(ctx); });
   return true;
 }
 

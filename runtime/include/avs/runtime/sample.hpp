@@ -2,10 +2,12 @@
 // by its publisher, then handed around as std::shared_ptr<const T>.
 #pragma once
 
+#include <atomic>
 #include <cstring>
 #include <memory>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include <dds/dds.h>
 
@@ -25,6 +27,36 @@ std::shared_ptr<T> make_sample() {
   });
 }
 
+/// Samples of T reused from message to message, so that a component publishing every frame
+/// allocates nothing once warm (issue 16 section 3). acquire() hands out a sample that no
+/// subscriber holds any more, else a new one (kept while fewer than `max_kept` are). A reused
+/// sample keeps the values and storage of its last message: the publisher sets every field, and
+/// sizes its sequences with resize_sequence and its strings with set_string, which reuse the
+/// storage. One pool per publisher, used from the component's own callbacks only.
+template <class T>
+class SamplePool {
+ public:
+  explicit SamplePool(std::size_t max_kept = 8) : max_kept_(max_kept) {}
+
+  std::shared_ptr<T> acquire() {
+    for (const auto& sample : kept_) {
+      // Only the pool holds it: nobody can take a new reference, so this is stable. The fence
+      // orders our writes after the last holder's reads (its release of the count).
+      if (sample.use_count() == 1) {
+        std::atomic_thread_fence(std::memory_order_acquire);
+        return sample;
+      }
+    }
+    std::shared_ptr<T> fresh = make_sample<T>();
+    if (kept_.size() < max_kept_) kept_.push_back(fresh);
+    return fresh;
+  }
+
+ private:
+  std::size_t max_kept_;
+  std::vector<std::shared_ptr<T>> kept_;
+};
+
 /// A zeroed sample of any type given by its descriptor and size (e.g. for dds_take of a type
 /// known at run time), freed with everything it gets.
 inline std::shared_ptr<void> make_sample(const dds_topic_descriptor_t* descriptor,
@@ -33,15 +65,21 @@ inline std::shared_ptr<void> make_sample(const dds_topic_descriptor_t* descripto
       dds_alloc(size), [descriptor](void* p) { dds_sample_free(p, descriptor, DDS_FREE_ALL); });
 }
 
-/// Replaces a C string field with a copy of `value`.
+/// Replaces a C string field with a copy of `value`, in the field's own storage when the
+/// string there is at least as long (a pooled sample's frame_id, set per message, costs no
+/// allocation; the storage was allocated for that string, so it holds strlen + 1 bytes).
 inline void set_string(char*& field, std::string_view value) {
-  dds_free(field);
-  field = static_cast<char*>(dds_alloc(value.size() + 1));
+  if (field == nullptr || std::strlen(field) < value.size()) {
+    dds_free(field);
+    field = static_cast<char*>(dds_alloc(value.size() + 1));
+  }
   std::memcpy(field, value.data(), value.size());
   field[value.size()] = '\0';
 }
 
-inline std::string_view get_string(const char* field) { return field ? field : ""; }
+inline std::string_view get_string(const char* field) {
+  return field ? field : "";
+}
 
 /// Resizes a Cyclone sequence (dds_sequence_xxx with _buffer/_length/_maximum/_release).
 /// New elements are zeroed; existing ones kept. Elements holding pointers must not shrink

@@ -5,6 +5,7 @@
 // the project keeps a focal length or a principal point.
 #pragma once
 
+#include <array>
 #include <span>
 #include <string>
 #include <vector>
@@ -36,6 +37,8 @@ struct CameraModel {
   }
   /// k1 k2 p1 p2 k3 [k4 k5 k6]: 5 for plumb_bob, 8 for rational_polynomial.
   std::vector<double> distortion_coefficients() const;
+  /// The same into `out` without an allocation (a CameraInfo per depth map); returns the count.
+  std::size_t distortion_coefficients(std::array<double, 8>& out) const;
   /// From 0, 4, 5 or 8 coefficients in OpenCV order (the missing ones are 0); returns false
   /// (and changes nothing) for any other count.
   bool set_distortion_coefficients(std::span<const double> d);
