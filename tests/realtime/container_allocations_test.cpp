@@ -5,6 +5,7 @@
 // callback per frame, fed rendered frames, allocates nothing either.
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/sample.hpp"
 #include "avs/testing/lockstep_graph.hpp"
+#include "avs/testing/test_domain.hpp"
 #include "ken_recording.hpp"
 
 namespace avs::testing {
@@ -204,6 +206,79 @@ class MarkerSink final : public runtime::Component {
 AVS_REGISTER_COMPONENT(PatternSource);
 AVS_REGISTER_COMPONENT(MarkerSink);
 
+/// The servo drive component's cycle in its container: a torque command every 1 ms (loaned),
+/// the drive's Modbus TCP exchange with both axes of sim_amplifier (its server answers on a
+/// thread of its own, not counted), safety rules, and the joint states and drive status it
+/// publishes. Graph order amplifier, source, drive, sink: at each instant the amplifier's plant
+/// step runs first (the simulator, not counted), then the source's tick arms the count, the
+/// drive takes the command and cycles, and the sink's delivery of the joint states ends it.
+class CommandSource final : public runtime::Component {
+ public:
+  static runtime::ComponentSpec spec() {
+    return {.type = "test_alloc_command_source",
+            .description =
+                "publishes a small sinusoidal torque command every 1 ms and arms the "
+                "allocation count",
+            .parameters = {},
+            .publishes = {runtime::port<msgs::avs_msgs::JointTorqueCommand>(
+                "command", "/head/torque_command")},
+            .subscribes = {}};
+  }
+  explicit CommandSource(runtime::ComponentContext& ctx)
+      : Component(ctx), command_(ctx.publisher<msgs::avs_msgs::JointTorqueCommand>("command")) {}
+  void on_activate() override {
+    timer_ = context().create_timer(std::chrono::milliseconds(1), [this] { tick(); });
+  }
+
+  long ticks = 0;
+  long counted = -1;  ///< allocations over the counted cycles (-1: not reached)
+
+ private:
+  void tick() {
+    if (ticks == kWarmUpTicks) reset_counted_allocations();
+    if (ticks == kWarmUpTicks + kCountedTicks) counted = counted_allocations();
+    count_allocations_on_this_thread(ticks >= kWarmUpTicks && ticks < kWarmUpTicks + kCountedTicks);
+    auto m = command_.loan();
+    runtime::to_ros_time(context().now(), m->header.stamp);
+    runtime::resize_sequence(m->name, 2);
+    runtime::resize_sequence(m->torque_nm, 2);
+    runtime::set_string(m->name._buffer[0], "pan");
+    runtime::set_string(m->name._buffer[1], "tilt");
+    const double t = static_cast<double>(ticks) * 1e-3;
+    m->torque_nm._buffer[0] = 0.05 * std::sin(2 * M_PI * t);
+    m->torque_nm._buffer[1] = 0.01 * std::sin(2 * M_PI * t);
+    command_.publish(std::move(m));
+    ++ticks;
+  }
+
+  runtime::Publisher<msgs::avs_msgs::JointTorqueCommand> command_;
+  runtime::TimerId timer_{};
+};
+
+/// Ends the count at each joint state; counts them.
+class JointStateSink final : public runtime::Component {
+ public:
+  static runtime::ComponentSpec spec() {
+    return {.type = "test_alloc_joint_state_sink",
+            .description = "ends the allocation count at each joint state; counts them",
+            .parameters = {},
+            .publishes = {},
+            .subscribes = {runtime::port<msgs::sensor_msgs::JointState>("joint_states",
+                                                                        "/head/joint_states")}};
+  }
+  explicit JointStateSink(runtime::ComponentContext& ctx) : Component(ctx) {
+    ctx.subscribe<msgs::sensor_msgs::JointState>(
+        "joint_states", [this](runtime::SamplePtr<msgs::sensor_msgs::JointState>) {
+          ++joint_states;
+          count_allocations_on_this_thread(false);
+        });
+  }
+  long joint_states = 0;
+};
+
+AVS_REGISTER_COMPONENT(CommandSource);
+AVS_REGISTER_COMPONENT(JointStateSink);
+
 TEST(ContainerAllocations, PublishDeliverAndTimerTicksAllocateNothingAfterWarmUp) {
   const ContainerRun run = run_lockstep_container(
       {"{type: test_alloc_source, name: source}", "{type: test_alloc_sink, name: sink}"},
@@ -234,6 +309,26 @@ TEST(ContainerAllocations, DecodeAndTrackingComponentsAllocateNothingPerFrameAft
   EXPECT_GE(sink->commands, sink->depth_maps - 1);
   EXPECT_EQ(source->counted, 0) << "allocations over " << kCountedFrames
                                 << " frames through the decode and tracking components";
+}
+
+TEST(ContainerAllocations, ServoDriveComponentAllocatesNothingPerCycleAfterWarmUp) {
+  const std::string port = std::to_string(test_tcp_port(0));
+  const ContainerRun run = run_lockstep_container(
+      {"{type: sim_amplifier, name: amplifier, parameters: {port: " + port +
+           ", plant_rate_hz: 1000}}",
+       "{type: test_alloc_command_source, name: source}",
+       "{type: servo_drive, name: drive, parameters: {port: " + port + ", cycle_rate_hz: 1000}}",
+       "{type: test_alloc_joint_state_sink, name: sink}"},
+      (kWarmUpTicks + kCountedTicks + 20) * 1e-3);
+  ASSERT_EQ(run.status, 0) << (run.load_errors.empty() ? "" : run.load_errors.front());
+  const auto* source = run.find<CommandSource>("source");
+  const auto* sink = run.find<JointStateSink>("sink");
+  ASSERT_NE(source, nullptr);
+  ASSERT_NE(sink, nullptr);
+  ASSERT_GE(source->ticks, kWarmUpTicks + kCountedTicks);
+  EXPECT_GE(sink->joint_states, kWarmUpTicks + kCountedTicks);  // the drive really cycled
+  EXPECT_EQ(source->counted, 0) << "allocations over " << kCountedTicks
+                                << " cycles of the servo drive component";
 }
 
 }  // namespace

@@ -571,7 +571,7 @@ class ServoDrive final : public runtime::Component {
   }
 
   void publish_joint_states(runtime::Time now, const CycleResult& r) {
-    auto msg = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    auto msg = joint_states_.loan();  // every field set below
     runtime::to_ros_time(now, msg->header.stamp);
     runtime::set_string(msg->header.frame_id, "head");
     const auto n = static_cast<std::uint32_t>(r.axes.size());
@@ -590,7 +590,7 @@ class ServoDrive final : public runtime::Component {
 
   void publish_status(runtime::Time now, const CycleResult& r) {
     const LinkStatistics s = client_->statistics();
-    auto msg = runtime::make_sample<msgs::avs_msgs::DriveStatus>();
+    auto msg = drive_status_.loan();  // every field set below (frame_id stays empty)
     runtime::to_ros_time(now, msg->header.stamp);
     const auto n = static_cast<std::uint32_t>(r.axes.size());
     runtime::resize_sequence(msg->axes, n);

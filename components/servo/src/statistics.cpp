@@ -18,7 +18,8 @@ void SampleWindow::add(double value) {
 
 double SampleWindow::percentile(double p) const {
   if (samples_.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::vector<double> copy = samples_;
+  std::vector<double>& copy = scratch_;
+  copy.assign(samples_.begin(), samples_.end());
   const double rank = std::ceil(std::clamp(p, 0.0, 100.0) / 100.0 * copy.size());
   const auto index = static_cast<std::size_t>(std::max(1.0, rank)) - 1;
   std::nth_element(copy.begin(), copy.begin() + static_cast<std::ptrdiff_t>(index), copy.end());
