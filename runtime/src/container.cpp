@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <deque>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -68,7 +69,8 @@ void deliver_sample(const void* context, const std::shared_ptr<const void>& samp
 
 /// Queues `sample` for `sub` on its lane (the one path of local and DDS-received samples),
 /// without an allocation (Scheduler::post with a function pointer). `sub` lives as long as the
-/// container: subscriptions are made before it runs and never removed.
+/// container and never moves: subscriptions are made before it runs, kept in a deque, never
+/// removed.
 void post_sample(Scheduler& scheduler, const LocalSubscription& sub,
                  std::shared_ptr<const void> sample) {
   const std::uint64_t sequence =
@@ -91,7 +93,9 @@ struct TopicEntry {
   bool latched = false;
   std::unique_ptr<dds::Reader> reader;
   dds::Entity read_condition;
-  std::vector<LocalSubscription> subscriptions;  // fixed once the container runs
+  /// A deque: queued deliveries point at their subscription (post_sample), and adding one
+  /// (before the container runs) must not move the others, even with a delivery already queued.
+  std::deque<LocalSubscription> subscriptions;
 };
 
 }  // namespace
@@ -443,15 +447,16 @@ class LocalPublisher final : public PublisherCore {
   void publish(std::shared_ptr<const void> sample, bool unchanged) {
     for (const auto& sub : topic_.subscriptions) post_sample(scheduler_, sub, sample);
     // Serialise only when a reader in another participant wants it, now or (latched) later;
-    // a latched copy equal to the one already in the history is not needed later.
-    topic_.tally.publish(
-        *topic_.writer, sample.get(),
-        (topic_.latched && !(unchanged && topic_.tally.cut().last_source_time_ns != 0)) ||
-            topic_.writer->matched_readers() > 0);
+    // an unchanged copy is not needed later once this publisher's own copy is in the history.
+    const bool send =
+        (topic_.latched && !(unchanged && sent_)) || topic_.writer->matched_readers() > 0;
+    topic_.tally.publish(*topic_.writer, sample.get(), send);
+    sent_ = sent_ || send;
   }
 
   Scheduler& scheduler_;
   TopicEntry& topic_;
+  bool sent_ = false;  ///< a sample of this publisher has been written to DDS
 };
 
 }  // namespace

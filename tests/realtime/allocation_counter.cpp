@@ -1,6 +1,7 @@
 #include "allocation_counter.hpp"
 
 #include <atomic>
+#include <cerrno>
 #include <cstddef>
 
 namespace {
@@ -28,9 +29,9 @@ void reset_counted_allocations() {
 }
 }  // namespace avs::testing
 
-// Every heap allocation goes through malloc (operator new, std::vector, Eigen, nanoflann's
-// pool): glibc lets a program replace malloc, calloc, realloc and free (and uses them for
-// memalign & co.); these count and forward to glibc's own.
+// Heap allocations go through malloc (operator new, std::vector, Eigen, nanoflann's pool),
+// calloc and realloc, or, aligned, through memalign, aligned_alloc and posix_memalign: glibc
+// lets a program replace all of them; these count and forward to glibc's own.
 extern "C" {
 void* __libc_malloc(std::size_t);
 void* __libc_calloc(std::size_t, std::size_t);
@@ -50,5 +51,24 @@ void* realloc(void* p, std::size_t size) {
 }
 void free(void* p) {
   __libc_free(p);
+}
+// Aligned allocations (operator new for over-aligned types, Eigen's aligned types) do not go
+// through malloc in glibc: counted here too.
+void* __libc_memalign(std::size_t, std::size_t);
+void* memalign(std::size_t alignment, std::size_t size) {
+  count();
+  return __libc_memalign(alignment, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size) {
+  count();
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** out, std::size_t alignment, std::size_t size) {
+  count();
+  if (alignment % sizeof(void*) != 0 || (alignment & (alignment - 1)) != 0) return EINVAL;
+  void* p = __libc_memalign(alignment, size);
+  if (p == nullptr) return ENOMEM;
+  *out = p;
+  return 0;
 }
 }

@@ -1,7 +1,7 @@
 // Heap allocations counted per thread, for the tests of issue 16 section 3 (no allocation per
-// frame after warm-up). allocation_counter.cpp replaces malloc, calloc and realloc for the whole
-// test program (so operator new, Eigen and nanoflann are all counted); only threads that armed
-// the count add to it.
+// frame after warm-up). allocation_counter.cpp replaces malloc, calloc, realloc and the
+// aligned allocators for the whole test program (so operator new, Eigen and nanoflann are all
+// counted); only threads that armed the count add to it.
 #pragma once
 
 namespace avs::testing {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -90,14 +91,19 @@ class Publisher {
   /// A sample to fill and publish, reused from an earlier message of this publisher once its
   /// subscribers have let it go (SamplePool: no allocation per message once warm, as ROS 2's
   /// loaned messages). It holds that message's values: set every field.
-  std::shared_ptr<T> loan() const { return pool_->acquire(); }
+  std::shared_ptr<T> loan() const {
+    if (!pool_) throw std::logic_error("Publisher::loan on a publisher the container did not make");
+    return pool_->acquire();
+  }
   const std::string& topic() const { return core_->topic(); }
   std::size_t reader_count() const { return core_->reader_count(); }
   explicit operator bool() const { return core_ != nullptr; }
 
  private:
   std::shared_ptr<PublisherCore> core_;
-  std::shared_ptr<SamplePool<T>> pool_;  ///< shared by copies of the publisher (one thread)
+  /// Shared by copies of the publisher; not thread-safe: loan from one thread (the component's
+  /// callbacks), as every component here does.
+  std::shared_ptr<SamplePool<T>> pool_;
 };
 
 /// Publishing end for serialised samples (CDR, the 4-byte encapsulation header included) of

@@ -82,8 +82,10 @@ inline std::string_view get_string(const char* field) {
 }
 
 /// Resizes a Cyclone sequence (dds_sequence_xxx with _buffer/_length/_maximum/_release).
-/// New elements are zeroed; existing ones kept. Elements holding pointers must not shrink
-/// (use only for plain element types, or grow only).
+/// Existing elements are kept; elements past the old maximum are zeroed, those between the old
+/// length and the maximum hold what they held (a loaned sample's earlier message: set them).
+/// Elements holding pointers must not shrink (use only for plain element types, constant
+/// lengths, or grow only).
 template <class Seq>
 void resize_sequence(Seq& seq, std::uint32_t length) {
   using Elem = std::remove_pointer_t<decltype(seq._buffer)>;
