@@ -49,5 +49,18 @@ TEST(JointHistory, TimeGoingBackStartsOverAndOldSamplesAreDropped) {
   EXPECT_DOUBLE_EQ(h.at(0.0005, 0.0)->pan_rad, 8.0);
 }
 
+TEST(JointHistory, KeepsASpanLongerThanItsFirstStorage) {
+  // 1 s at 1 kHz: four times the storage it starts with, which grows to hold it all.
+  JointHistory h(1.0);
+  for (int i = 0; i <= 3000; ++i) h.add({i * 0.001, i * 0.001, -i * 0.001});
+  EXPECT_GE(h.size(), 1000u);
+  EXPECT_LE(h.size(), 1002u);
+  const auto oldest = h.at(2.0015, 0.0);
+  ASSERT_TRUE(oldest.has_value()) << "a stamp 1 s back is still inside the history";
+  EXPECT_NEAR(oldest->pan_rad, 2.0015, 1e-9);
+  EXPECT_NEAR(oldest->tilt_rad, -2.0015, 1e-9);
+  EXPECT_NEAR(h.at(2.9995, 0.0)->pan_rad, 2.9995, 1e-9);
+}
+
 }  // namespace
 }  // namespace avs::matching

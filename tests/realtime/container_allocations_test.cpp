@@ -1,8 +1,8 @@
 // Issue 16 section 3, in a container: a sample published by one component and delivered to
 // another on the same lane (the intra-process path every frame takes: publish, the lane's queue,
 // the subscription's callback), and a timer's tick, allocate nothing after warm-up (the source
-// reuses one sample, so what is counted is the container's); and the decode component's whole
-// callback per frame, fed rendered frames, allocates nothing either.
+// reuses one sample, so what is counted is the container's); and the decode, tracking, matching
+// and servo drive components' whole callbacks, fed rendered frames, allocate nothing either.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -207,6 +207,36 @@ class MarkerSink final : public runtime::Component {
 AVS_REGISTER_COMPONENT(PatternSource);
 AVS_REGISTER_COMPONENT(MarkerSink);
 
+/// Ends the count at each marker and each /object/match (matching publishes one per depth map,
+/// after its pose, world pose, timing and clouds); counts the matches and the tracked ones.
+class MatchSink final : public runtime::Component {
+ public:
+  static runtime::ComponentSpec spec() {
+    return {.type = "test_alloc_match_sink",
+            .description = "ends the allocation count at each marker and match; counts them",
+            .parameters = {},
+            .publishes = {},
+            .subscribes = {runtime::port<msgs::std_msgs::Float64>("marker", "alloc_marker"),
+                           runtime::port<msgs::avs_msgs::MatchResult>("match", "/object/match")}};
+  }
+  explicit MatchSink(runtime::ComponentContext& ctx) : Component(ctx) {
+    ctx.subscribe<msgs::std_msgs::Float64>("marker",
+                                           [](runtime::SamplePtr<msgs::std_msgs::Float64>) {
+                                             count_allocations_on_this_thread(false);
+                                           });
+    ctx.subscribe<msgs::avs_msgs::MatchResult>(
+        "match", [this](runtime::SamplePtr<msgs::avs_msgs::MatchResult> m) {
+          ++matches;
+          if (m->state == avs_msgs_msg_dds__MatchResult_Constants_STATE_TRACKING) ++tracked;
+          count_allocations_on_this_thread(false);
+        });
+  }
+  long matches = 0;
+  long tracked = 0;
+};
+
+AVS_REGISTER_COMPONENT(MatchSink);
+
 /// The servo drive component's cycle in its container: a torque command every 1 ms (loaned),
 /// the drive's Modbus TCP exchange with both axes of sim_amplifier (its server answers on a
 /// thread of its own, not counted), safety rules, and the joint states and drive status it
@@ -343,6 +373,32 @@ TEST(ContainerAllocations, DecodeAndTrackingComponentsAllocateNothingPerFrameAft
   EXPECT_GE(sink->commands, sink->depth_maps - 1);
   EXPECT_EQ(source->counted, 0) << "allocations over " << kCountedFrames
                                 << " frames through the decode and tracking components";
+}
+
+// The matching component with closed_loop.yaml's parameters (clouds published too), fed by
+// decode: counted from each frame's publish to the delivery of its /object/match, so decode's
+// callback is inside the count as well.
+TEST(ContainerAllocations, MatchingComponentAllocatesNothingPerDepthMapAfterWarmUp) {
+  const ContainerRun run = run_lockstep_container(
+      {"{type: test_alloc_pattern_source, name: source}",
+       "{type: decode, name: decode, parameters: {subcode_half_window: 4}}",
+       "{type: matching, name: matching, parameters: {model: ken, publish_scene_points: true, "
+       "publish_model_points: true, lag_compensation_s: 0.009, velocity_window_s: 0.03, "
+       "icp_model: dense, icp_max_distance_m: 0.015, scene_points: 500, scene_voxel_m: 0.005, "
+       "outlier_neighbours: 8, icp_iterations: [0, 0, 2], reacquire_within_s: 0.05}}",
+       "{type: test_alloc_match_sink, name: sink}"},
+      (kWarmUpFrames + kCountedFrames + 20) * 1e-3);
+  ASSERT_EQ(run.status, 0) << (run.load_errors.empty() ? "" : run.load_errors.front());
+  const auto* source = run.find<PatternSource>("source");
+  const auto* sink = run.find<MatchSink>("sink");
+  ASSERT_NE(source, nullptr);
+  ASSERT_NE(sink, nullptr);
+  ASSERT_GE(source->frames, kWarmUpFrames + kCountedFrames);
+  // It really matched: a result per depth map, and the ken tracked in most of them.
+  EXPECT_GE(sink->matches, (kWarmUpFrames + kCountedFrames) / 2 - 20);
+  EXPECT_GT(sink->tracked, kCountedFrames / 4);
+  EXPECT_EQ(source->counted, 0) << "allocations over " << kCountedFrames
+                                << " frames through the decode and matching components";
 }
 
 TEST(ContainerAllocations, ServoDriveComponentAllocatesNothingPerCycleAfterWarmUp) {

@@ -5,6 +5,7 @@ namespace avs::matching {
 void JointHistory::add(const Sample& s) {
   if (!samples_.empty() && s.t_s < samples_.back().t_s) samples_.clear();  // time went back
   if (!samples_.empty() && s.t_s == samples_.back().t_s) samples_.pop_back();
+  if (samples_.full()) samples_.set_capacity(2 * samples_.capacity());
   samples_.push_back(s);
   while (samples_.size() > 2 && samples_.back().t_s - samples_.front().t_s > keep_s_) {
     samples_.pop_front();

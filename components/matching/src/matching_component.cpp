@@ -7,10 +7,11 @@
 // /object/match, /timing and, optionally, /object/scene_points.
 #include <cmath>
 #include <cstring>
-#include <deque>
 #include <fstream>
 #include <optional>
 #include <utility>
+
+#include <boost/circular_buffer.hpp>
 
 #include "avs/geometry/frames.hpp"
 #include "avs/geometry/head_kinematics.hpp"
@@ -322,8 +323,8 @@ class MatchingComponent final : public runtime::Component {
 
   void on_info(const msgs::avs_msgs::DepthInfo& m) {
     if (!use_depth_info_ || !std::isfinite(m.data_age_s) || m.data_age_s < 0.0) return;
+    // When full, the oldest is overwritten.
     ages_.push_back({runtime::from_ros_time(m.header.stamp).seconds(), m.data_age_s});
-    while (ages_.size() > 16) ages_.pop_front();
   }
 
   /// The data age /depth/info gave for this stamp, if it came.
@@ -381,7 +382,7 @@ class MatchingComponent final : public runtime::Component {
   void publish_pose(const runtime::Publisher<msgs::geometry_msgs::PoseStamped>& publisher,
                     const decltype(msgs::sensor_msgs::Image::header.stamp)& stamp,
                     std::string_view frame, const Eigen::Isometry3d& T) {
-    auto msg = runtime::make_sample<msgs::geometry_msgs::PoseStamped>();
+    auto msg = publisher.loan();  // every field set below
     msg->header.stamp = stamp;
     runtime::set_string(msg->header.frame_id, frame);
     msg::to_pose(T, msg->pose);
@@ -408,7 +409,7 @@ class MatchingComponent final : public runtime::Component {
   }
 
   void publish_match(const msgs::sensor_msgs::Image& image, const PipelineOutput& out) {
-    auto msg = runtime::make_sample<msgs::avs_msgs::MatchResult>();
+    auto msg = match_.loan();  // every field set below
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, geometry::frame::kCameraOptical);
     msg::to_pose(out.T_camera_model.cast<double>(), msg->pose);
@@ -422,7 +423,7 @@ class MatchingComponent final : public runtime::Component {
   }
 
   void publish_timing(const msgs::sensor_msgs::Image& image, double processing_ms) {
-    auto msg = runtime::make_sample<msgs::avs_msgs::StageTiming>();
+    auto msg = timing_.loan();  // every field set below
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, runtime::get_string(image.header.frame_id));
     runtime::set_string(msg->stage, "matching");
@@ -432,7 +433,7 @@ class MatchingComponent final : public runtime::Component {
 
   void publish_cloud(const msgs::sensor_msgs::Image& image) {
     const Points& points = pipeline_->scene_points();
-    auto msg = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
+    auto msg = scene_points_.loan();  // every field set below (write_xyz_cloud: all but the header)
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, geometry::frame::kCameraOptical);
     msg::write_xyz_cloud(points, *msg);
@@ -445,7 +446,7 @@ class MatchingComponent final : public runtime::Component {
     const Points& model = pipeline_->model().points_m;
     model_in_camera_.resize(model.size());
     for (std::size_t i = 0; i < model.size(); ++i) model_in_camera_[i] = T_camera_model * model[i];
-    auto msg = runtime::make_sample<msgs::sensor_msgs::PointCloud2>();
+    auto msg = model_points_.loan();  // every field set below (write_xyz_cloud: all but the header)
     msg->header.stamp = image.header.stamp;
     runtime::set_string(msg->header.frame_id, geometry::frame::kCameraOptical);
     msg::write_xyz_cloud(model_in_camera_, *msg);
@@ -484,7 +485,8 @@ class MatchingComponent final : public runtime::Component {
   std::string report_dir_;
   double max_extrapolation_s_;
   bool use_depth_info_;
-  std::deque<std::pair<double, double>> ages_;  // (stamp, data age) from /depth/info
+  /// (stamp, data age) of the newest 16 /depth/info; fixed storage, no allocation per message.
+  boost::circular_buffer<std::pair<double, double>> ages_{16};
   runtime::SampleRejections rejected_{log(), "input"};
   msg::CameraInput camera_{log(), rejected_};  ///< from /depth/camera_info
   bool warned_no_joints_ = false;

@@ -155,7 +155,7 @@ class SimAmplifier final : public runtime::Component {
   }
 
   void publish_state() {
-    auto msg = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    auto msg = head_state_.loan();  // every field set below
     runtime::to_ros_time(context().now(), msg->header.stamp);
     runtime::set_string(msg->header.frame_id, "head");
     runtime::resize_sequence(msg->name, 2);

@@ -320,7 +320,7 @@ class PatternReplay final : public runtime::Component {
     const std::int64_t replay_cycle = slot / per_cycle;
     const Recorded& r = frames_[static_cast<std::size_t>(recorded_cycle(replay_cycle) * per_cycle +
                                                          slot % per_cycle)];
-    auto m = runtime::make_sample<msgs::avs_msgs::PatternFrame>();
+    auto m = pattern_.loan();  // every field set below
     runtime::set_string(m->header.frame_id, geometry::frame::kCameraOptical);
     auto& image = m->image;
     runtime::set_string(image.header.frame_id, geometry::frame::kCameraOptical);
@@ -328,6 +328,7 @@ class PatternReplay final : public runtime::Component {
     image.width = static_cast<std::uint32_t>(width_);
     image.height = static_cast<std::uint32_t>(height_);
     image.step = image.width;
+    image.is_bigendian = 0;
     runtime::resize_sequence(image.data, static_cast<std::uint32_t>(r.pixels.size()));
     std::copy(r.pixels.begin(), r.pixels.end(), image.data._buffer);
     m->bit_index = static_cast<std::uint8_t>(r.pattern.bit_index);
@@ -337,7 +338,7 @@ class PatternReplay final : public runtime::Component {
     m->pan_rad = r.pan_rad;
     m->tilt_rad = r.tilt_rad;
 
-    auto joints = runtime::make_sample<msgs::sensor_msgs::JointState>();
+    auto joints = joints_.loan();  // every field set below (frame_id and effort stay empty)
     runtime::resize_sequence(joints->name, 2);
     runtime::resize_sequence(joints->position, 2);
     runtime::resize_sequence(joints->velocity, 2);

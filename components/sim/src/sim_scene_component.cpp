@@ -354,7 +354,7 @@ class SimScene final : public runtime::Component {
     ++frames_;
     publish_pattern(frame, now);
     publish_truth(frame, now);
-    auto timing = runtime::make_sample<msgs::avs_msgs::StageTiming>();
+    auto timing = timing_.loan();  // every field set below
     runtime::to_ros_time(now, timing->header.stamp);
     runtime::set_string(timing->header.frame_id, geometry::frame::kCameraOptical);
     runtime::set_string(timing->stage, "render");
@@ -363,7 +363,7 @@ class SimScene final : public runtime::Component {
   }
 
   void publish_pattern(const SimFrame& frame, runtime::Time stamp) {
-    auto m = runtime::make_sample<msgs::avs_msgs::PatternFrame>();
+    auto m = pattern_.loan();  // every field set below
     runtime::to_ros_time(stamp, m->header.stamp);
     runtime::set_string(m->header.frame_id, geometry::frame::kCameraOptical);
     auto& image = m->image;
@@ -387,7 +387,7 @@ class SimScene final : public runtime::Component {
 
   void publish_truth(const SimFrame& frame, runtime::Time stamp) {
     for (const ObjectTruth& o : frame.truth.objects) {
-      auto m = runtime::make_sample<msgs::avs_msgs::GroundTruth>();
+      auto m = truth_.loan();  // every field set below
       runtime::to_ros_time(stamp, m->header.stamp);
       runtime::set_string(m->header.frame_id, geometry::frame::kWorld);
       runtime::set_string(m->object_name, o.name);
