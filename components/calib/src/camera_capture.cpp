@@ -112,7 +112,7 @@ std::optional<BoardView> CameraCapture::capture_view(
     if (!frame->complete) {
       // An incomplete frame breaks the run of ids: the assembler starts again after it.
       assembler.reset();
-      reasons.add("incomplete frame (" + frame->status + ")");
+      reasons.add(std::string("incomplete frame (") + frame->status + ")");
       continue;
     }
     // Frames exposed before the board was placed still come out of the buffers.

@@ -5,6 +5,7 @@
 #include <arv.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -61,7 +62,7 @@ std::string choose_device(const std::string& wanted, const std::vector<std::stri
   return found.front().substr(0, found.front().find(" ("));
 }
 
-std::string status_text(ArvBufferStatus status) {
+const char* status_text(ArvBufferStatus status) {
   switch (status) {
     case ARV_BUFFER_STATUS_SUCCESS:
       return "success";
@@ -80,7 +81,7 @@ std::string status_text(ArvBufferStatus status) {
     case ARV_BUFFER_STATUS_ABORTED:
       return "aborted";
     default:
-      return "unknown status " + std::to_string(static_cast<int>(status));
+      return "unknown status";
   }
 }
 
@@ -400,14 +401,66 @@ void AravisCamera::stop() {
   e.check(impl_->where() + ": AcquisitionStop");
 }
 
+/// A stream buffer while it is out of the stream. Back into the stream at the first next()
+/// after its frame's last holder let go, or when it is destroyed (a frame still held after the
+/// AravisCamera is gone: it keeps the stream alive until then, as a frame always did).
+struct AravisCamera::Lease {
+  ArvBuffer* buffer = nullptr;
+  std::shared_ptr<Impl> impl;
+  bool out = false;
+
+  Lease(ArvBuffer* b, std::shared_ptr<Impl> i) : buffer(b), impl(std::move(i)) {}
+  Lease(const Lease&) = delete;
+  Lease& operator=(const Lease&) = delete;
+  ~Lease() {
+    if (out) arv_stream_push_buffer(impl->stream.get(), buffer);
+  }
+};
+
+int AravisCamera::return_released_buffers() {
+  int held = 0;
+  for (const auto& lease : leases_) {
+    if (!lease->out) continue;
+    // Only leases_ holds it: nobody can take a new reference. The fence orders Aravis's
+    // writes into the buffer after the last holder's reads (its release of the count).
+    if (lease.use_count() == 1) {
+      std::atomic_thread_fence(std::memory_order_acquire);
+      lease->out = false;
+      arv_stream_push_buffer(impl_->stream.get(), lease->buffer);
+    } else {
+      ++held;
+    }
+  }
+  return held;
+}
+
+const std::shared_ptr<AravisCamera::Lease>& AravisCamera::lease_of(void* buffer) {
+  for (const auto& lease : leases_) {
+    if (lease->buffer == buffer) return lease;
+  }
+  leases_.push_back(std::make_shared<Lease>(static_cast<ArvBuffer*>(buffer), impl_));
+  return leases_.back();
+}
+
 std::optional<CapturedFrame> AravisCamera::next(std::chrono::milliseconds timeout) {
-  ArvBuffer* buffer = arv_stream_timeout_pop_buffer(impl_->stream.get(),
-                                                    static_cast<guint64>(timeout.count()) * 1000);
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  ArvBuffer* buffer = nullptr;
+  for (;;) {
+    const int held = return_released_buffers();
+    const auto now = std::chrono::steady_clock::now();
+    auto wait = std::chrono::duration_cast<std::chrono::microseconds>(deadline - now);
+    // With (nearly) every buffer held, one let go while we wait would stay out until the wait
+    // ends: wait in short steps then, returning buffers between them.
+    if (held >= impl_->config.buffer_count - 1) {
+      wait = std::min(wait, std::chrono::microseconds(1000));
+    }
+    wait = std::max(wait, std::chrono::microseconds(0));
+    buffer = arv_stream_timeout_pop_buffer(impl_->stream.get(), static_cast<guint64>(wait.count()));
+    if (buffer != nullptr || std::chrono::steady_clock::now() >= deadline) break;
+  }
   if (buffer == nullptr) return std::nullopt;
-  // The lease pushes the buffer back into the pool; it keeps the stream (Impl) alive.
-  std::shared_ptr<const void> lease(buffer, [impl = impl_](const void* b) {
-    arv_stream_push_buffer(impl->stream.get(), static_cast<ArvBuffer*>(const_cast<void*>(b)));
-  });
+  const std::shared_ptr<Lease>& lease = lease_of(buffer);
+  lease->out = true;
   CapturedFrame f;
   const ArvBufferStatus status = arv_buffer_get_status(buffer);
   f.complete = status == ARV_BUFFER_STATUS_SUCCESS;
@@ -428,11 +481,11 @@ std::optional<CapturedFrame> AravisCamera::next(std::chrono::milliseconds timeou
     f.stride = f.width;
     if (f.data == nullptr || size < static_cast<size_t>(f.width) * static_cast<size_t>(f.height)) {
       f.complete = false;
-      f.status =
-          "image data smaller than " + std::to_string(f.width) + "x" + std::to_string(f.height);
+      f.status = "image data smaller than its width x height";
     }
   }
-  f.lease = std::move(lease);
+  // Aliases the buffer's lease: no allocation.
+  f.lease = std::shared_ptr<const void>(lease, buffer);
   return f;
 }
 

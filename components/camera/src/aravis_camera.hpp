@@ -1,7 +1,8 @@
 // A GenICam camera through Aravis 0.8: open (by id or the only one found), configure the
 // features of CameraConfig with one-line errors, stream into a fixed pool of buffers. Frames
-// are lent: a CapturedFrame's lease returns its buffer to the stream when the last holder
-// drops it (no allocation and no copy per frame). No Aravis or glib types in this header.
+// are lent: a CapturedFrame's lease keeps its buffer out of the stream while anyone holds it;
+// the next call to next() after the last holder let go returns it (no copy, and no allocation
+// per frame after each buffer's first use). No Aravis or glib types in this header.
 #pragma once
 
 #include <chrono>
@@ -25,7 +26,7 @@ struct CapturedFrame {
   std::int64_t camera_timestamp_ns = 0;
   std::int64_t host_timestamp_ns = 0;  ///< host realtime clock when the buffer completed
   bool complete = false;
-  std::string status;                 ///< Aravis buffer status ("success", "missing packets", ...)
+  const char* status = "";            ///< Aravis buffer status ("success", "missing packets", ...)
   std::shared_ptr<const void> lease;  ///< keeps the buffer out of the pool while held
 };
 
@@ -67,13 +68,22 @@ class AravisCamera {
   /// with the one line of a refused configuration (feature, value, what the camera allows);
   /// a refused value changes nothing on the camera. Not thread-safe against itself.
   void set_exposure_and_gain(double exposure_us, double gain);
-  /// The next buffer (complete or not), or nothing after `timeout`.
+  /// The next buffer (complete or not), or nothing after `timeout`. First returns to the
+  /// stream every buffer whose frames nobody holds any more. Call from one thread.
   std::optional<CapturedFrame> next(std::chrono::milliseconds timeout);
   StreamCounters counters() const;
 
  private:
   struct Impl;
+  struct Lease;
+  /// Returns released buffers to the stream; how many are still held.
+  int return_released_buffers();
+  const std::shared_ptr<Lease>& lease_of(void* buffer);
+
   std::shared_ptr<Impl> impl_;
+  /// One per stream buffer, made at its first frame: a frame's lease aliases it, so lending a
+  /// frame allocates nothing.
+  std::vector<std::shared_ptr<Lease>> leases_;
 };
 
 }  // namespace avs::camera

@@ -22,6 +22,7 @@
 #include "avs/geometry/frames.hpp"
 #include "avs/runtime/component.hpp"
 #include "avs/runtime/config_params.hpp"
+#include "avs/runtime/lent_sample_pool.hpp"
 #include "avs/runtime/rejections.hpp"
 
 namespace avs::camera {
@@ -29,30 +30,6 @@ namespace avs::camera {
 using runtime::ComponentContext;
 using runtime::ComponentSpec;
 using runtime::ParamSpec;
-
-namespace {
-
-/// A sample of T whose image bytes (the sequence `data_of(sample)`) are the camera buffer of
-/// `lease`: not copied, not freed by the sample; the buffer returns to the pool when the last
-/// sample holding it is gone.
-template <class T, class DataOf>
-std::shared_ptr<T> lend(DataOf data_of, const std::uint8_t* data, std::size_t size,
-                        std::shared_ptr<const void> lease) {
-  auto* raw = static_cast<T*>(dds_alloc(sizeof(T)));  // zeroed
-  std::shared_ptr<T> sample(raw, [data_of, lease = std::move(lease)](T* p) {
-    auto& seq = data_of(*p);
-    seq._buffer = nullptr;
-    seq._length = seq._maximum = 0;
-    dds_sample_free(p, msg::TypeSupport<T>::descriptor(), DDS_FREE_ALL);
-  });
-  auto& seq = data_of(*raw);
-  seq._buffer = const_cast<std::uint8_t*>(data);
-  seq._length = seq._maximum = static_cast<std::uint32_t>(size);
-  seq._release = false;
-  return sample;
-}
-
-}  // namespace
 
 class CameraComponent final : public runtime::Component {
  public:
@@ -269,6 +246,10 @@ class CameraComponent final : public runtime::Component {
   void capture_loop() {
     const auto timeout = std::chrono::milliseconds(config_.buffer_timeout_ms);
     while (!stop_) {
+      // Samples nobody holds any more let go of their buffers, which next() then returns to
+      // the stream.
+      pattern_samples_.release_unused();
+      raw_samples_.release_unused();
       std::optional<CapturedFrame> frame = camera_->next(timeout);
       if (!frame) continue;
       try {
@@ -375,17 +356,14 @@ class CameraComponent final : public runtime::Component {
     const auto min_step_ns = static_cast<std::int64_t>(1e9 / rate_hz);
     if (last_raw_ns_ != 0 && f.host_timestamp_ns - last_raw_ns_ < min_step_ns) return;
     last_raw_ns_ = f.host_timestamp_ns;
-    auto m = lend<msgs::sensor_msgs::Image>(
-        [](msgs::sensor_msgs::Image & i) -> auto& { return i.data; }, f.data, f.size, f.lease);
+    auto m = raw_samples_.lend(f.data, f.size, f.lease);  // every field set below
     fill_image(*m, f, stamp);
     image_raw_.publish(std::move(m));
   }
 
   void publish_pattern(const Held& h, const FrameLabel& label) {
     const CapturedFrame& f = h.frame;
-    auto m = lend<msgs::avs_msgs::PatternFrame>(
-        [](msgs::avs_msgs::PatternFrame & p) -> auto& { return p.image.data; }, f.data, f.size,
-        f.lease);
+    auto m = pattern_samples_.lend(f.data, f.size, f.lease);  // every field set below
     runtime::to_ros_time(h.stamp, m->header.stamp);
     runtime::set_string(m->header.frame_id, frame_id_);
     fill_image(m->image, f, h.stamp);
@@ -407,6 +385,12 @@ class CameraComponent final : public runtime::Component {
   std::unique_ptr<AravisCamera> camera_;
 
   // Capture thread only.
+  /// The published samples, kept with their strings; their image bytes are the camera's
+  /// buffers, lent (no copy, no allocation per frame).
+  runtime::LentSamplePool<msgs::avs_msgs::PatternFrame> pattern_samples_{
+      [](msgs::avs_msgs::PatternFrame& p) -> dds_sequence_uint8& { return p.image.data; }};
+  runtime::LentSamplePool<msgs::sensor_msgs::Image> raw_samples_{
+      [](msgs::sensor_msgs::Image& i) -> dds_sequence_uint8& { return i.data; }};
   std::thread thread_;
   std::atomic<bool> stop_{false};
   std::uint64_t token_ = 0;
