@@ -7,9 +7,13 @@
 
 #include <array>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <thread>
 
 #include "allocation_counter.hpp"
 #include "aravis_camera.hpp"
@@ -126,6 +130,84 @@ TEST(CameraAllocations, AravisFramesAreLentWithoutAllocatingAndTheirBuffersComeB
   ASSERT_EQ(frames, 360) << "the stream ran dry: buffers not returned?";
   EXPECT_GT(complete, 180);  // a loaded host may lose packets on loopback; not the subject here
   EXPECT_EQ(counted, 0) << "allocations over 300 frames lent by AravisCamera";
+}
+
+/// The camera component's arrangement with few buffers: each frame lent into a pooled sample
+/// that a subscriber on another thread holds for 12 ms (more than two frame periods), so the
+/// stream runs out of buffers again and again. A buffer the subscriber lets go while next()
+/// waits comes back within its 1 ms step through the release hook; without it the capture
+/// stalled until next()'s timeout (1 s here) each time.
+TEST(CameraAllocations, BuffersLetGoWhileTheCaptureWaitsComeBackWithinAStep) {
+  constexpr int kWidth = 512, kHeight = 512;
+  camera::SimGigECameraConfig served_config;
+  served_config.frame_rate_hz = 200;
+  camera::SimGigECamera served(served_config, kWidth, kHeight,
+                               [](std::uint64_t k, std::uint8_t* out) {
+                                 std::memset(out, static_cast<int>(k % 251), kWidth * kHeight);
+                               });
+  camera::CameraConfig config;
+  config.device_id = "127.0.0.1";
+  config.trigger_mode = camera::TriggerMode::kFreeRun;
+  config.frame_rate_hz = 200;
+  config.width = kWidth;
+  config.height = kHeight;
+  config.buffer_count = 3;
+  config.socket_buffer_bytes = 8 << 20;
+  camera::AravisCamera camera(config);
+  runtime::LentSamplePool<PatternFrame> pool(&image_bytes);
+  camera.set_release_hook([&pool] { pool.release_unused(); });
+
+  // The subscriber: holds each sample 12 ms after it arrived, then lets it go.
+  std::mutex mutex;
+  std::condition_variable arrived;
+  std::deque<std::pair<std::chrono::steady_clock::time_point, std::shared_ptr<const PatternFrame>>>
+      queue;
+  bool done = false;
+  std::thread subscriber([&] {
+    std::unique_lock lock(mutex);
+    while (!done || !queue.empty()) {
+      if (queue.empty()) {
+        arrived.wait(lock);
+        continue;
+      }
+      const auto due = queue.front().first + std::chrono::milliseconds(12);
+      if (std::chrono::steady_clock::now() < due) {
+        arrived.wait_until(lock, due);
+        continue;
+      }
+      queue.pop_front();  // lets go of the sample
+    }
+  });
+
+  camera.start();
+  int frames = 0;
+  auto last = std::chrono::steady_clock::now();
+  std::chrono::steady_clock::duration longest{};
+  const auto deadline = last + std::chrono::seconds(60);
+  while (frames < 200 && std::chrono::steady_clock::now() < deadline) {
+    std::optional<camera::CapturedFrame> f = camera.next(std::chrono::milliseconds(1000));
+    const auto now = std::chrono::steady_clock::now();
+    if (frames > 10) longest = std::max(longest, now - last);
+    last = now;
+    if (!f) continue;
+    ++frames;
+    auto sample = pool.lend(f->data, f->size, std::move(f->lease));
+    std::lock_guard lock(mutex);
+    queue.emplace_back(now, std::move(sample));
+    arrived.notify_one();
+  }
+  {
+    std::lock_guard lock(mutex);
+    done = true;
+    arrived.notify_one();
+  }
+  subscriber.join();
+  camera.stop();
+  ASSERT_EQ(frames, 200);
+  // A stall is next()'s 1 s timeout; frames come every 5 ms and a buffer back within a step
+  // (a loaded host may add some scheduling delay).
+  EXPECT_LT(std::chrono::duration<double>(longest).count(), 0.5)
+      << "the capture waited for a buffer that had been let go";
 }
 
 }  // namespace

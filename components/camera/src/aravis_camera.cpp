@@ -446,6 +446,7 @@ std::optional<CapturedFrame> AravisCamera::next(std::chrono::milliseconds timeou
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   ArvBuffer* buffer = nullptr;
   for (;;) {
+    if (release_hook_) release_hook_();
     const int held = return_released_buffers();
     const auto now = std::chrono::steady_clock::now();
     auto wait = std::chrono::duration_cast<std::chrono::microseconds>(deadline - now);

@@ -7,6 +7,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -68,9 +69,15 @@ class AravisCamera {
   /// with the one line of a refused configuration (feature, value, what the camera allows);
   /// a refused value changes nothing on the camera. Not thread-safe against itself.
   void set_exposure_and_gain(double exposure_us, double gain);
-  /// The next buffer (complete or not), or nothing after `timeout`. First returns to the
-  /// stream every buffer whose frames nobody holds any more. Call from one thread.
+  /// The next buffer (complete or not), or nothing after `timeout` (0: only what is there).
+  /// First returns to the stream every buffer whose frames nobody holds any more; with
+  /// (nearly) every buffer held it waits in 1 ms steps and does so between them. Call from one
+  /// thread.
   std::optional<CapturedFrame> next(std::chrono::milliseconds timeout);
+  /// Called on next()'s thread before each of its steps: whoever keeps frames' leases in
+  /// samples of their own (runtime::LentSamplePool) lets go of the unused ones there, so that
+  /// a buffer let go while next() waits comes back within a step. Set before streaming.
+  void set_release_hook(std::function<void()> hook) { release_hook_ = std::move(hook); }
   StreamCounters counters() const;
 
  private:
@@ -81,6 +88,7 @@ class AravisCamera {
   const std::shared_ptr<Lease>& lease_of(void* buffer);
 
   std::shared_ptr<Impl> impl_;
+  std::function<void()> release_hook_;
   /// One per stream buffer, made at its first frame: a frame's lease aliases it, so lending a
   /// frame allocates nothing.
   std::vector<std::shared_ptr<Lease>> leases_;

@@ -157,6 +157,12 @@ class CameraComponent final : public runtime::Component {
   }
 
   void on_activate() override {
+    // Samples nobody holds any more let go of their buffers before and while next() waits,
+    // which then returns them to the stream (capture thread).
+    camera_->set_release_hook([this] {
+      pattern_samples_.release_unused();
+      raw_samples_.release_unused();
+    });
     camera_->start();
     stop_ = false;
     thread_ = std::thread([this] { capture_loop(); });
@@ -246,10 +252,6 @@ class CameraComponent final : public runtime::Component {
   void capture_loop() {
     const auto timeout = std::chrono::milliseconds(config_.buffer_timeout_ms);
     while (!stop_) {
-      // Samples nobody holds any more let go of their buffers, which next() then returns to
-      // the stream.
-      pattern_samples_.release_unused();
-      raw_samples_.release_unused();
       std::optional<CapturedFrame> frame = camera_->next(timeout);
       if (!frame) continue;
       try {

@@ -19,7 +19,8 @@ namespace avs::runtime {
 /// lend() hands out a sample of T whose byte sequence `data_of(sample)` points at the caller's
 /// bytes and which holds the caller's lease. A kept sample nobody holds any more lets go of its
 /// lease at the next lend() or release_unused() (where the buffer goes back to its driver: the
-/// owner calls release_unused() before it waits for the next buffer). Beyond `max_kept` samples
+/// owner calls release_unused() before and while it waits for the next buffer, e.g. through
+/// AravisCamera::set_release_hook). Beyond `max_kept` samples
 /// in flight a sample is made for one use and lets go of its lease with its last holder. A
 /// reused sample keeps its last message's values: the caller sets every field (set_string reuses
 /// the strings' storage). Used from one thread; holders may be on any.
@@ -51,6 +52,7 @@ class LentSamplePool {
     std::shared_ptr<Slot> slot;
     for (const auto& kept : kept_) {
       if (kept.use_count() == 1) {
+        std::atomic_thread_fence(std::memory_order_acquire);  // as in release_unused()
         slot = kept;
         break;
       }
