@@ -84,26 +84,37 @@ TEST(CameraAllocations, LentSamplesAllocateNothingOnceWarmAndLeasesGoWithTheLast
   EXPECT_EQ(buffers.out(), 0) << "both frames let go of their buffers";
 }
 
-/// Frames over GigE Vision on loopback from Aravis's fake camera, taken on this thread with
-/// AravisCamera::next() and each held for two more frames (as the sequencer holds them) with
-/// only 4 stream buffers: counted over 300 frames after 60, nothing allocated on this thread.
-TEST(CameraAllocations, AravisFramesAreLentWithoutAllocatingAndTheirBuffersComeBack) {
-  constexpr int kWidth = 512, kHeight = 512;
-  camera::SimGigECameraConfig served_config;
-  served_config.frame_rate_hz = 200;
-  camera::SimGigECamera served(served_config, kWidth, kHeight,
-                               [](std::uint64_t k, std::uint8_t* out) {
+/// Aravis's fake camera on loopback at 200 Hz, 512 x 512, each frame one grey level.
+struct LoopbackCamera {
+  static constexpr int kWidth = 512, kHeight = 512;
+  static camera::SimGigECameraConfig config() {
+    camera::SimGigECameraConfig c;
+    c.frame_rate_hz = 200;
+    return c;
+  }
+  camera::SimGigECamera served{config(), kWidth, kHeight, [](std::uint64_t k, std::uint8_t* out) {
                                  std::memset(out, static_cast<int>(k % 251), kWidth * kHeight);
-                               });
+                               }};
+};
+
+camera::CameraConfig loopback_config(int buffers) {
   camera::CameraConfig config;
   config.device_id = "127.0.0.1";
   config.trigger_mode = camera::TriggerMode::kFreeRun;
   config.frame_rate_hz = 200;
-  config.width = kWidth;
-  config.height = kHeight;
-  config.buffer_count = 4;
+  config.width = LoopbackCamera::kWidth;
+  config.height = LoopbackCamera::kHeight;
+  config.buffer_count = buffers;
   config.socket_buffer_bytes = 8 << 20;
-  camera::AravisCamera camera(config);
+  return config;
+}
+
+/// Frames over GigE Vision on loopback from Aravis's fake camera, taken on this thread with
+/// AravisCamera::next() and each held for two more frames (as the sequencer holds them) with
+/// only 4 stream buffers: counted over 300 frames after 60, nothing allocated on this thread.
+TEST(CameraAllocations, AravisFramesAreLentWithoutAllocatingAndTheirBuffersComeBack) {
+  const LoopbackCamera loopback;
+  camera::AravisCamera camera(loopback_config(4));
   camera.start();
   std::array<camera::CapturedFrame, 2> held;  // a ring: a std::deque would allocate by itself
   int frames = 0, complete = 0;
@@ -138,22 +149,8 @@ TEST(CameraAllocations, AravisFramesAreLentWithoutAllocatingAndTheirBuffersComeB
 /// waits comes back within its 1 ms step through the release hook; without it the capture
 /// stalled until next()'s timeout (1 s here) each time.
 TEST(CameraAllocations, BuffersLetGoWhileTheCaptureWaitsComeBackWithinAStep) {
-  constexpr int kWidth = 512, kHeight = 512;
-  camera::SimGigECameraConfig served_config;
-  served_config.frame_rate_hz = 200;
-  camera::SimGigECamera served(served_config, kWidth, kHeight,
-                               [](std::uint64_t k, std::uint8_t* out) {
-                                 std::memset(out, static_cast<int>(k % 251), kWidth * kHeight);
-                               });
-  camera::CameraConfig config;
-  config.device_id = "127.0.0.1";
-  config.trigger_mode = camera::TriggerMode::kFreeRun;
-  config.frame_rate_hz = 200;
-  config.width = kWidth;
-  config.height = kHeight;
-  config.buffer_count = 3;
-  config.socket_buffer_bytes = 8 << 20;
-  camera::AravisCamera camera(config);
+  const LoopbackCamera loopback;
+  camera::AravisCamera camera(loopback_config(3));
   runtime::LentSamplePool<PatternFrame> pool(&image_bytes);
   camera.set_release_hook([&pool] { pool.release_unused(); });
 
