@@ -154,5 +154,21 @@ TEST_F(MeshIoTest, PlyListLengthsAndIndicesMustBeWholeNumbersInRange) {
       << error_of(path("n.ply"));
 }
 
+// tests/fuzz found a vertex element with a list property before x, y, z read its coordinates
+// one place off and past the item's values (ASan: heap-buffer-overflow in add_item).
+TEST_F(MeshIoTest, PlyVertexWithAListPropertyBeforeItsCoordinatesReadsThemRight) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty list uchar int extra\n"
+      "property float x\nproperty float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const Mesh mesh = load_mesh(write("v.ply", header + "2 7 8 0.5 0 0\n1 9 1 0.25 0\n0 0 1 0.125\n"
+                                                      "3 0 1 2\n"));
+  ASSERT_EQ(mesh.vertices.size(), 3u);
+  EXPECT_EQ(mesh.vertices[0], Eigen::Vector3f(0.5F, 0, 0));
+  EXPECT_EQ(mesh.vertices[1], Eigen::Vector3f(1, 0.25F, 0));
+  EXPECT_EQ(mesh.vertices[2], Eigen::Vector3f(0, 1, 0.125F));
+  ASSERT_EQ(mesh.triangles.size(), 1u);
+}
+
 }  // namespace
 }  // namespace avs::geometry

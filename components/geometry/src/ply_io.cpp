@@ -194,9 +194,14 @@ struct ItemSink {
   std::vector<int> list;        ///< the (last) list property's items
 };
 
+/// Where the scalar property `name` is in an item's `scalars` (which leave the list properties
+/// out: a vertex with a list property before x read past them, found by tests/fuzz), or -1.
 int index_of(const Element& e, const char* name) {
-  for (std::size_t i = 0; i < e.properties.size(); ++i) {
-    if (e.properties[i].name == name && !e.properties[i].is_list) return static_cast<int>(i);
+  int scalar = 0;
+  for (const Property& property : e.properties) {
+    if (property.is_list) continue;
+    if (property.name == name) return scalar;
+    ++scalar;
   }
   return -1;
 }
