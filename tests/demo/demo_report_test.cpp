@@ -6,6 +6,7 @@
 #include <png.h>
 #include <sys/wait.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -113,9 +114,11 @@ TEST(Demo, RealtimePacesSimulatedTimeByTheWallClockAndSaysSo) {
   const fs::path dir = fs::temp_directory_path() / ("avs-demo-rt-" + std::to_string(getpid()));
   fs::remove_all(dir);
   const std::string log = dir.string() + ".log";
+  const auto started = std::chrono::steady_clock::now();
   const int status = avs::testing::run_avs(
-      {"demo", "--seconds", "0.2", "--realtime", "0.05", "--out", dir.string()}, log,
-      log + ".err");
+      {"demo", "--seconds", "0.2", "--realtime", "0.05", "--out", dir.string()}, log, log + ".err");
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   const std::string output = read_file(log) + read_file(log + ".err");
   ASSERT_EQ(status, 0) << output;
   EXPECT_NE(output.find("paced by the wall clock at 0.05 x real time"), std::string::npos)
@@ -124,10 +127,18 @@ TEST(Demo, RealtimePacesSimulatedTimeByTheWallClockAndSaysSo) {
       << output;
   EXPECT_NE(read_file(dir / "index.html").find("paced by the wall clock at 0.05 x real time"),
             std::string::npos);
-  const avs::report::Summary s = avs::report::compute_summary(avs::report::load_run(dir));
+  const avs::report::RunData run = avs::report::load_run(dir);
+  const avs::report::Summary s = avs::report::compute_summary(run);
   ASSERT_TRUE(std::isfinite(s.real_time_factor)) << output;
-  // First to last row: within a frame period of the pacing (10 %), never lockstep's pace.
-  EXPECT_LE(s.real_time_factor, 0.05 * 1.1) << output;
+  // Never faster than the pacing: the simulated time reached is at most 0.05 x the wall time
+  // the program ran (10 %: the clocks' granularity). Not first to last row: the paced clock
+  // starts with the scheduler, before the components are built, so a slow start (ASan in CI,
+  // 2026-12-07) makes the first rows late and the next ones catch up, which gave 0.063 from
+  // first to last row though the pacing held.
+  ASSERT_FALSE(run.frames.empty());
+  EXPECT_LE(run.frames.back().t_s, 0.05 * 1.1 * wall_s)
+      << "simulated " << run.frames.back().t_s << " s in " << wall_s << " s\n"
+      << output;
   // Enough rows for the factor to mean something. Not more: under ASan on a loaded machine the
   // start-up takes most of the run's wall-clock budget (8 depth maps once in CI, 2026-12-06), and
   // a test must not depend on the machine's speed.
