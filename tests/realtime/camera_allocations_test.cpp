@@ -147,7 +147,7 @@ TEST(CameraAllocations, AravisFramesAreLentWithoutAllocatingAndTheirBuffersComeB
 /// that a subscriber on another thread holds for 12 ms (more than two frame periods), so the
 /// stream runs out of buffers again and again. A buffer the subscriber lets go while next()
 /// waits comes back within its 1 ms step through the release hook; without it the capture
-/// stalled until next()'s timeout (1 s here) each time.
+/// stalled until next()'s timeout (4 s here) each time.
 TEST(CameraAllocations, BuffersLetGoWhileTheCaptureWaitsComeBackWithinAStep) {
   const LoopbackCamera loopback;
   camera::AravisCamera camera(loopback_config(3));
@@ -182,7 +182,7 @@ TEST(CameraAllocations, BuffersLetGoWhileTheCaptureWaitsComeBackWithinAStep) {
   std::chrono::steady_clock::duration longest{};
   const auto deadline = last + std::chrono::seconds(60);
   while (frames < 200 && std::chrono::steady_clock::now() < deadline) {
-    std::optional<camera::CapturedFrame> f = camera.next(std::chrono::milliseconds(1000));
+    std::optional<camera::CapturedFrame> f = camera.next(std::chrono::milliseconds(4000));
     const auto now = std::chrono::steady_clock::now();
     if (frames > 10) longest = std::max(longest, now - last);
     last = now;
@@ -201,9 +201,9 @@ TEST(CameraAllocations, BuffersLetGoWhileTheCaptureWaitsComeBackWithinAStep) {
   subscriber.join();
   camera.stop();
   ASSERT_EQ(frames, 200);
-  // A stall is next()'s 1 s timeout; frames come every 5 ms and a buffer back within a step
+  // A stall is next()'s 4 s timeout; frames come every 5 ms and a buffer back within a step
   // (a loaded host may add some scheduling delay).
-  EXPECT_LT(std::chrono::duration<double>(longest).count(), 0.5)
+  EXPECT_LT(std::chrono::duration<double>(longest).count(), 2.0)
       << "the capture waited for a buffer that had been let go";
 }
 
