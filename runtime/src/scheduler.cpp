@@ -58,7 +58,7 @@ std::int64_t system_ns() {
 }  // namespace
 
 Scheduler::Scheduler(TimeMode mode, double real_time_factor)
-    : mode_(mode), real_time_factor_(real_time_factor), steady_start_ns_(steady_ns()) {
+    : mode_(mode), real_time_factor_(real_time_factor) {
   if (mode == TimeMode::sim_realtime && !(real_time_factor > 0)) {
     throw Error("real_time_factor must be > 0, got " + std::to_string(real_time_factor));
   }
@@ -129,7 +129,8 @@ Time Scheduler::now_locked() const {
     case TimeMode::wall:
       return {system_ns()};
     case TimeMode::sim_realtime: {
-      const double elapsed = static_cast<double>(steady_ns() - steady_start_ns_);
+      if (!steady_start_ns_) return Time{0};  // held until the lanes start
+      const double elapsed = static_cast<double>(steady_ns() - *steady_start_ns_);
       return {static_cast<std::int64_t>(elapsed * real_time_factor_)};
     }
     case TimeMode::sim_follower:
@@ -186,6 +187,9 @@ bool Scheduler::all_idle_locked() const {
 void Scheduler::run_lane(int lane_index) {
   std::unique_lock lock(mutex_);
   Lane& lane = *lanes_.at(static_cast<std::size_t>(lane_index));
+  // The first lane to start anchors the paced clock: timers made before (at activation) fall
+  // due one period after it, as they would had the clock started then.
+  if (mode_ == TimeMode::sim_realtime && !steady_start_ns_) steady_start_ns_ = steady_ns();
   while (!stopping_) {
     if (end_ && now_locked() >= *end_) {
       stopping_ = true;
@@ -248,7 +252,7 @@ void Scheduler::wait_locked(std::unique_lock<std::mutex>& lock, int lane_index) 
       const std::int64_t target =
           next ? next->first : (now_locked() + std::chrono::milliseconds(1)).ns;
       const auto wake = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(
-          steady_start_ns_ +
+          *steady_start_ns_ +
           static_cast<std::int64_t>(static_cast<double>(target) / real_time_factor_)));
       changed_.wait_until(lock, wake);
       const Time t = now_locked();

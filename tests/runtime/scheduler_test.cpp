@@ -54,6 +54,25 @@ TEST(SchedulerTest, LockstepWaitsForEveryLaneBeforeAdvancing) {
   for (std::int64_t lag : handled_at) EXPECT_EQ(lag, 0) << "time moved while the consumer was busy";
 }
 
+// Paced simulated time starts with the lanes, not with the scheduler: what happens between
+// (the container building and activating its components, seconds under a sanitizer) is not
+// simulated time. Before the fix the clock ran from construction, so here the whole run
+// (0.5 s) had passed before the lane started, and the timer never fired.
+TEST(SchedulerTest, RealtimeClockStartsWithTheLanesNotWithTheScheduler) {
+  Scheduler scheduler(TimeMode::sim_realtime, 1.0);
+  const int lane = scheduler.add_lane();
+  std::vector<std::int64_t> fired_ns;
+  scheduler.add_timer(lane, milliseconds(100), [&] { fired_ns.push_back(scheduler.now().ns); });
+  scheduler.stop_at(Time{500'000'000});
+  std::this_thread::sleep_for(milliseconds(600));  // "start-up"
+  EXPECT_EQ(scheduler.now().ns, 0) << "the clock ran before any lane did";
+
+  scheduler.run_lane(lane);
+  ASSERT_FALSE(fired_ns.empty());
+  EXPECT_GE(fired_ns.front(), 100'000'000);  // one period after the lanes started
+  EXPECT_GE(scheduler.now().ns, 500'000'000);
+}
+
 TEST(SchedulerTest, PostedCallbacksRunInOrder) {
   Scheduler scheduler(TimeMode::sim_lockstep);
   const int lane = scheduler.add_lane();

@@ -47,6 +47,10 @@ class Scheduler {
   std::uint64_t add_timer(int lane, Duration period, Callback fn);
   void cancel_timer(std::uint64_t id);
 
+  /// sim_realtime: simulated time stands at 0 until the first lane starts (run_lane), then
+  /// advances at the real-time factor from there: building and activating the components
+  /// (seconds for a model's distance grid, more under a sanitizer) is not simulated time, so
+  /// the loop does not start behind and fire its first timers in a burst to catch up.
   Time now() const;
   TimeMode mode() const { return mode_; }
 
@@ -96,7 +100,7 @@ class Scheduler {
   std::map<std::uint64_t, std::int64_t> timer_deadlines_;  // id -> deadline, for cancel
   std::uint64_t next_timer_id_ = 1;
   Time sim_now_{0};
-  std::int64_t steady_start_ns_ = 0;  // sim_realtime: wall origin
+  std::optional<std::int64_t> steady_start_ns_;  // sim_realtime: wall origin, from run_lane
   std::optional<Time> end_;
   bool stopping_ = false;
   std::function<void(Time)> time_advanced_;
