@@ -629,6 +629,96 @@ TEST(BagRecord, ReportedLossEqualsTheGapsInTheRecordingUnderLoad) {
 
 // Issue 20 section 6: a lockstep graph waits for the recorder (its default): the same run,
 // recorder stopped for a second, loses nothing, and the file has every period.
+// A recorder meant to run for days splits its file (docs/reliability.md, soak: an MCAP writer
+// keeps one chunk-index entry per chunk until it closes the file). The bag_recorder component
+// does what `avs bag record --max-duration/--max-size` does: each file complete on its own
+// (a summary, readable without repair), the files in order, none lost or repeated.
+TEST(BagRecord, TheGraphRecorderSplitsItsFileByDurationAndBySizeLosingNothing) {
+  const auto record = [](const std::string& name, const std::string& option) {
+    const fs::path first = temp_dir() / (name + ".mcap");
+    AvsProcess graph({"launch", source_dir() + "/tests/bag/data/split_recording.yaml",
+                      "out:=" + first.string(), option},
+                     temp_dir() / (name + ".log"));
+    EXPECT_EQ(exit_code(graph.wait(120s)), 0) << graph.output();
+    std::vector<std::vector<Recorded>> files;
+    for (int i = 0;; ++i) {
+      const fs::path file =
+          i == 0 ? first : temp_dir() / (name + "_" + std::to_string(i) + ".mcap");
+      if (!fs::exists(file)) break;
+      mcap::Reader reader;
+      EXPECT_TRUE(reader.open(file).ok()) << file;
+      const mcap::Status summary = reader.read_summary();
+      EXPECT_TRUE(summary.ok()) << file
+                                << " was not closed with its summary: " << summary.to_string();
+      files.push_back(read_all(file));
+    }
+    return std::pair{files, graph.output()};
+  };
+
+  // 1 s of a 1 kHz talker, a new file every 0.25 s of log time.
+  {
+    const auto [files, output] = record("split_duration", "max_duration_s:=0.25");
+    ASSERT_GE(files.size(), 4u) << output;
+    EXPECT_LE(files.size(), 5u) << output;
+    std::vector<std::uint64_t> seqs;
+    for (const auto& file : files) {
+      ASSERT_FALSE(file.empty());
+      EXPECT_LT(file.back().log_time - file.front().log_time, 250'000'000u)
+          << "a file covers less than max_duration_s";
+      const auto file_seqs = chatter_sequence(file);
+      seqs.insert(seqs.end(), file_seqs.begin(), file_seqs.end());
+    }
+    expect_consecutive(seqs, "across the files");
+    EXPECT_GE(seqs.size(), 990u) << output;
+    EXPECT_NE(output.find("recording continues in"), std::string::npos) << output;
+  }
+  // The same by size: each file stops growing once it has reached 0.01 MB (its last chunk
+  // may take it past).
+  {
+    const auto [files, output] = record("split_size", "max_size_mb:=0.01");
+    ASSERT_GE(files.size(), 3u) << output;
+    std::vector<std::uint64_t> seqs;
+    for (const auto& file : files) {
+      const auto file_seqs = chatter_sequence(file);
+      seqs.insert(seqs.end(), file_seqs.begin(), file_seqs.end());
+    }
+    expect_consecutive(seqs, "across the files");
+    EXPECT_GE(seqs.size(), 990u) << output;
+  }
+}
+
+// `avs bag record --max-duration` (the same rule as the component's, file_split.hpp): the
+// talker's stream over several files, each complete, nothing lost or repeated between them.
+TEST(BagRecord, TheRecordCommandSplitsByDurationLosingNothing) {
+  AvsProcess graph({"launch", talker_graph(), "rate_hz:=200"}, temp_dir() / "split_talker.log");
+  ASSERT_TRUE(graph.started());
+  std::this_thread::sleep_for(1500ms);
+  const fs::path first = temp_dir() / "split_cli.mcap";
+  AvsProcess rec({"bag", "record", "/chatter", "-o", first.string(), "--duration", "1.6",
+                  "--max-duration", "0.5"},
+                 temp_dir() / "split_cli_record.log");
+  ASSERT_EQ(exit_code(rec.wait(30s)), 0) << rec.output();
+  std::vector<std::uint64_t> seqs;
+  int files = 0;
+  for (int i = 0;; ++i) {
+    const fs::path file =
+        i == 0 ? first : temp_dir() / ("split_cli_" + std::to_string(i) + ".mcap");
+    if (!fs::exists(file)) break;
+    ++files;
+    mcap::Reader reader;
+    ASSERT_TRUE(reader.open(file).ok()) << file;
+    EXPECT_TRUE(reader.read_summary().ok()) << file << " has no summary";
+    const auto messages = read_all(file);
+    ASSERT_FALSE(messages.empty()) << file;
+    EXPECT_LT(messages.back().log_time - messages.front().log_time, 500'000'000u) << file;
+    const auto file_seqs = chatter_sequence(messages);
+    seqs.insert(seqs.end(), file_seqs.begin(), file_seqs.end());
+  }
+  EXPECT_GE(files, 3) << rec.output();
+  expect_consecutive(seqs, "across the files");
+  EXPECT_GT(seqs.size(), 200u) << rec.output();
+}
+
 TEST(BagRecord, ALockstepGraphWaitsForItsRecorderAndNothingIsLost) {
   std::string out;
   int status = -1;

@@ -8,9 +8,11 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "avs/bag/file_split.hpp"
 #include "avs/bag/qos_yaml.hpp"
 #include "avs/introspection/type_database.hpp"
 #include "avs/mcap/writer.hpp"
@@ -49,7 +51,14 @@ class BagRecorderComponent final : public runtime::Component {
                        ParamSpec::real("max_chunk_age_s", 1.0, 0.0, 3600.0, "s",
                                        "a chunk is written once its first message is this old "
                                        "(container clock): what a killed recorder can lose; "
-                                       "0: chunks close by size only")},
+                                       "0: chunks close by size only"),
+                       ParamSpec::real("max_size_mb", 0.0, 0.0, 1e9, "MB",
+                                       "start a new file (<stem>_1.mcap, <stem>_2.mcap, ...) "
+                                       "when one reaches this size; each file is complete on "
+                                       "its own (0: one file)"),
+                       ParamSpec::real("max_duration_s", 0.0, 0.0, 1e9, "s",
+                                       "start a new file when one covers this much log time "
+                                       "(container clock; 0: no limit)")},
         .open_ports = true,
     };
   }
@@ -57,19 +66,21 @@ class BagRecorderComponent final : public runtime::Component {
   explicit BagRecorderComponent(runtime::ComponentContext& ctx)
       : Component(ctx),
         file_(file_to_write(ctx.param<std::string>("file"), ctx.param<std::string>("if_exists"))),
-        max_chunk_age_ns_(static_cast<std::int64_t>(ctx.param<double>("max_chunk_age_s") * 1e9)) {
+        max_chunk_age_ns_(static_cast<std::int64_t>(ctx.param<double>("max_chunk_age_s") * 1e9)),
+        split_{static_cast<std::uint64_t>(ctx.param<double>("max_size_mb") * 1e6),
+               ctx.param<double>("max_duration_s")},
+        if_exists_(ctx.param<std::string>("if_exists")),
+        current_file_(file_) {
     if (file_ != ctx.param<std::string>("file")) {
       log().warn("bag_recorder: ", ctx.param<std::string>("file"),
                  " exists and is kept (if_exists: keep); recording into ", file_);
     }
     const std::string topics = ctx.param<std::string>("topics");
     if (topics.empty()) throw runtime::Error("bag_recorder: parameter 'topics' is required");
-    mcap::WriterOptions options;
     const std::string compression = ctx.param<std::string>("compression");
-    options.compression = compression == "lz4"    ? mcap::Compression::lz4
-                          : compression == "none" ? mcap::Compression::none
-                                                  : mcap::Compression::zstd;
-    check(writer_.open(file_, options), "open");
+    options_.compression = compression == "lz4"    ? mcap::Compression::lz4
+                           : compression == "none" ? mcap::Compression::none
+                                                   : mcap::Compression::zstd;
     runtime::QosProfile qos;
     qos.depth = static_cast<std::uint32_t>(ctx.param<int>("depth"));
     for (const std::string& name : msg::parse_name_list(topics, 0, "topics")) {
@@ -77,22 +88,24 @@ class BagRecorderComponent final : public runtime::Component {
       channel.topic = name;
       const std::string dds_type = ctx.serialized_subscription(
           name, "", qos, [this, &channel](std::span<const std::byte> cdr) { write(channel, cdr); });
-      const std::string ros_type = introspection::ros_type_name(dds_type);
-      mcap::SchemaId schema = 0;
-      check(writer_.add_schema(
-                ros_type, "ros2msg",
-                introspection::ros2msg_definition(introspection::built_in_types(), dds_type),
-                schema),
-            "add schema " + ros_type);
+      channel.ros_type = introspection::ros_type_name(dds_type);
+      channel.definition =
+          introspection::ros2msg_definition(introspection::built_in_types(), dds_type);
       const std::vector<runtime::dds::EndpointQos> offered = {
           runtime::dds::EndpointQos::from_profile(qos)};
-      check(writer_.add_channel(name, "cdr", schema,
-                                {{"offered_qos_profiles", offered_qos_yaml(offered)},
-                                 {"topic_type_hash", ""}},
-                                channel.id),
-            "add channel " + name);
+      channel.offered_qos = offered_qos_yaml(offered);
     }
+    open_file();
     log().info("recording ", channels_.size(), " topic(s) into ", file_);
+    if (split_.max_size_bytes > 0 || split_.max_duration_s > 0) {
+      std::ostringstream when;
+      if (split_.max_size_bytes > 0)
+        when << "once one reaches " << ctx.param<double>("max_size_mb") << " MB";
+      if (split_.max_size_bytes > 0 && split_.max_duration_s > 0) when << " or ";
+      if (split_.max_duration_s > 0)
+        when << "once one covers " << split_.max_duration_s << " s of log time";
+      log().info("a new file (", split_path(file_, 1).filename().string(), ", ...) ", when.str());
+    }
   }
 
   void on_shutdown() override { close(); }
@@ -108,15 +121,67 @@ class BagRecorderComponent final : public runtime::Component {
     std::lock_guard lock(mutex_);
     return {{"written", std::to_string(written_)},
             {"not_written", std::to_string(not_written_)},
-            {"file", file_},
+            {"file", current_file_},
+            {"file_index", std::to_string(file_index_)},
             {"error", failure_}};
   }
 
  private:
   struct Channel {
     std::string topic;
-    mcap::ChannelId id = 0;
+    std::string ros_type;     ///< schema name
+    std::string definition;   ///< schema data (ros2msg)
+    std::string offered_qos;  ///< channel metadata
+    mcap::ChannelId id = 0;   ///< in the open file
   };
+
+  /// Opens file number file_index_ (split_path) with every channel; the first on construction,
+  /// the next ones when the split rule starts a new file.
+  void open_file() {
+    check(writer_.open(current_file_, options_), "open");
+    for (auto& [name, channel] : channels_) {
+      mcap::SchemaId schema = 0;
+      check(writer_.add_schema(channel.ros_type, "ros2msg", channel.definition, schema),
+            "add schema " + channel.ros_type);
+      check(
+          writer_.add_channel(
+              name, "cdr", schema,
+              {{"offered_qos_profiles", channel.offered_qos}, {"topic_type_hash", ""}}, channel.id),
+          "add channel " + name);
+    }
+    file_start_ns_ = -1;
+  }
+
+  /// Closes the open file (complete, with its summary) and continues in the next one.
+  mcap::Status next_file() {
+    mcap::Status status = writer_.close();
+    if (!status.ok()) return status;
+    const std::string closed = current_file_;
+    // Never over another recording: with if_exists keep a name that exists is skipped.
+    namespace fs = std::filesystem;
+    int index = file_index_ + 1;
+    std::error_code ec;
+    for (; if_exists_ != "overwrite" && fs::exists(split_path(file_, index), ec); ++index) {
+      if (if_exists_ == "fail" || index >= file_index_ + 100000) {
+        return {mcap::StatusCode::io_error,
+                split_path(file_, index).string() + " exists (if_exists: " + if_exists_ + ")"};
+      }
+      log().warn("bag_recorder: ", split_path(file_, index).string(),
+                 " exists and is kept (if_exists: keep); skipping to the next name");
+    }
+    {
+      std::lock_guard lock(mutex_);
+      file_index_ = index;
+      current_file_ = split_path(file_, file_index_).string();
+    }
+    try {
+      open_file();
+    } catch (const std::exception& e) {
+      return {mcap::StatusCode::io_error, e.what()};
+    }
+    log().info("closed ", closed, ", recording continues in ", current_file_);
+    return status;
+  }
 
   /// A write the file refuses (disk full, I/O error) ends the recording, loudly, and only the
   /// recording: the rest of the graph goes on (issue 20 section 5). What was written stays
@@ -127,9 +192,16 @@ class BagRecorderComponent final : public runtime::Component {
       ++not_written_;
       return;
     }
-    const auto now =
-        static_cast<mcap::Timestamp>(std::max<std::int64_t>(0, context().now().ns));
-    mcap::Status status = writer_.write(channel.id, now, now, cdr);
+    const auto now = static_cast<mcap::Timestamp>(std::max<std::int64_t>(0, context().now().ns));
+    mcap::Status status;
+    if (file_start_ns_ >= 0 &&
+        split_.starts_new_file(writer_.statistics().file_bytes,
+                               static_cast<std::uint64_t>(file_start_ns_), now)) {
+      status = next_file();
+      chunk_start_ns_ = -1;
+    }
+    if (file_start_ns_ < 0) file_start_ns_ = static_cast<std::int64_t>(now);
+    if (status.ok()) status = writer_.write(channel.id, now, now, cdr);
     if (status.ok() && max_chunk_age_ns_ > 0) {
       // Bounds what a SIGKILL can take: only the chunk being filled is lost with the process.
       if (chunk_start_ns_ < 0) {
@@ -146,7 +218,8 @@ class BagRecorderComponent final : public runtime::Component {
     }
     ++not_written_;
     failure_ = "write " + channel.topic + ": " + status.to_string();
-    log().error("bag_recorder: ", file_, ": ", failure_, ": recording STOPPED after ", written_,
+    log().error("bag_recorder: ", current_file_, ": ", failure_, ": recording STOPPED after ",
+                written_,
                 " message(s); the rest of the graph goes on; the file is readable up to its last "
                 "complete chunk (`avs bag repair` gives it a summary)");
   }
@@ -159,14 +232,15 @@ class BagRecorderComponent final : public runtime::Component {
       // What the file holds: the chunks written before the failure; the messages of the
       // chunk being filled then are lost with it.
       const std::uint64_t in_file = writer_.statistics().messages_in_file;
-      log().error("bag_recorder: ", file_, ": ", in_file, " message(s) in the file, ",
+      log().error("bag_recorder: ", current_file_, ": ", in_file, " message(s) in the file, ",
                   not_written_ + written_ - std::min(written_, in_file), " NOT written (", failure_,
                   ")");
     } else if (!status.ok()) {
-      log().error("bag_recorder: ", file_, ": close: ", status.to_string(), " (", written_,
+      log().error("bag_recorder: ", current_file_, ": close: ", status.to_string(), " (", written_,
                   " message(s) written; `avs bag repair` rebuilds the summary)");
     } else {
-      log().info("wrote ", written_, " message(s) to ", file_);
+      log().info("wrote ", written_, " message(s) to ", file_,
+                 file_index_ > 0 ? " .. " + current_file_ : std::string());
     }
   }
 
@@ -194,13 +268,20 @@ class BagRecorderComponent final : public runtime::Component {
   /// A write the file refused is a failure of the run (a recording must not lose silently).
   void check(const mcap::Status& status, const std::string& what) const {
     if (!status.ok()) {
-      throw runtime::Error("bag_recorder: " + file_ + ": " + what + ": " + status.to_string());
+      throw runtime::Error("bag_recorder: " + current_file_ + ": " + what + ": " +
+                           status.to_string());
     }
   }
 
-  const std::string file_;
+  const std::string file_;  ///< the first file; split_path names the next ones
   const std::int64_t max_chunk_age_ns_;
   std::int64_t chunk_start_ns_ = -1;  ///< log time of the open chunk's first message; -1: none
+  const FileSplit split_;
+  const std::string if_exists_;  ///< for the split files too
+  mcap::WriterOptions options_;
+  int file_index_ = 0;               ///< of the open file (0: file_)
+  std::string current_file_;         ///< the open file
+  std::int64_t file_start_ns_ = -1;  ///< log time of its first message; -1: none yet
   mcap::Writer writer_;
   std::map<std::string, Channel> channels_;
   mutable std::mutex mutex_;  ///< the counts and failure_ are read by the diagnostics timer

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <thread>
 
+#include "avs/bag/file_split.hpp"
 #include "avs/bag/qos_yaml.hpp"
 #include "avs/bag/receipt_ledger.hpp"
 #include "avs/introspection/type_database.hpp"
@@ -46,14 +47,6 @@ std::string ros_topic_of(const std::string& name) {
 /// 0.1 s), then how long to keep taking for the samples those counts name.
 constexpr auto kFinalReportWait = std::chrono::milliseconds(500);
 constexpr auto kFinalSampleGrace = std::chrono::milliseconds(100);
-
-std::filesystem::path split_path(const std::filesystem::path& first, int index) {
-  if (index == 0) return first;
-  std::filesystem::path p = first;
-  const std::string ext = p.has_extension() ? p.extension().string() : std::string(".mcap");
-  p.replace_filename(p.stem().string() + "_" + std::to_string(index) + ext);
-  return p;
-}
 
 }  // namespace
 
@@ -552,12 +545,8 @@ struct Recorder::Impl {
         for (std::size_t i = 0; i < batch.size(); ++i) {
           QueuedSample& s = batch[i];
           if (file_start == 0) file_start = s.log_time;
-          const bool too_big = options.max_size_bytes > 0 && file_bytes >= options.max_size_bytes;
-          const bool too_long =
-              options.max_duration_s > 0 &&
-              static_cast<double>(s.log_time - std::min(s.log_time, file_start)) * 1e-9 >=
-                  options.max_duration_s;
-          if (too_big || too_long) {
+          if (FileSplit{options.max_size_bytes, options.max_duration_s}.starts_new_file(
+                  file_bytes, file_start, s.log_time)) {
             check(writer.close(), "close " + split_path(options.output, file_index).string());
             ++file_index;
             open_file();
