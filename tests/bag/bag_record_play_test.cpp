@@ -627,8 +627,6 @@ TEST(BagRecord, ReportedLossEqualsTheGapsInTheRecordingUnderLoad) {
   EXPECT_NE(info.output().find(expected_line), std::string::npos) << info.output();
 }
 
-// Issue 20 section 6: a lockstep graph waits for the recorder (its default): the same run,
-// recorder stopped for a second, loses nothing, and the file has every period.
 // A recorder meant to run for days splits its file (docs/reliability.md, soak: an MCAP writer
 // keeps one chunk-index entry per chunk until it closes the file). The bag_recorder component
 // does what `avs bag record --max-duration/--max-size` does: each file complete on its own
@@ -719,6 +717,8 @@ TEST(BagRecord, TheRecordCommandSplitsByDurationLosingNothing) {
   EXPECT_GT(seqs.size(), 200u) << rec.output();
 }
 
+// Issue 20 section 6: a lockstep graph waits for the recorder (its default): the same run,
+// recorder stopped for a second, loses nothing, and the file has every period.
 TEST(BagRecord, ALockstepGraphWaitsForItsRecorderAndNothingIsLost) {
   std::string out;
   int status = -1;
