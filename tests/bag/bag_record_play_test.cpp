@@ -717,6 +717,52 @@ TEST(BagRecord, TheRecordCommandSplitsByDurationLosingNothing) {
   EXPECT_GT(seqs.size(), 200u) << rec.output();
 }
 
+// The same wait on a light graph (a 1 kHz talker), so that ThreadSanitizer runs it (the closed
+// loop's recordings take more than their 300 s under TSan): 20 s of simulated time (under a
+// second here), the recorder stopped for a second at 5 s, the graph waits, and the file has every
+// message, in order.
+TEST(BagRecord, ALockstepTalkerWaitsForItsStoppedRecorder) {
+  const fs::path file = temp_dir() / "lockstep_talker.mcap";
+  AvsProcess rec({"bag", "record", "/chatter", "-o", file.string()},
+                 temp_dir() / "lockstep_talker_record.log");
+  ASSERT_TRUE(rec.started());
+  std::this_thread::sleep_for(1500ms);
+  {
+    AvsProcess graph({"launch", source_dir() + "/tests/bag/data/lockstep_talker.yaml"},
+                     temp_dir() / "lockstep_talker_graph.log");
+    ASSERT_TRUE(graph.started());
+    SimClockWatch clock;
+    const auto give_up = std::chrono::steady_clock::now() + 120s;
+    while (clock.now_s() < 5.0 && std::chrono::steady_clock::now() < give_up)
+      std::this_thread::sleep_for(5ms);
+    rec.signal(SIGSTOP);
+    // The steps already under way (and the /clock samples in flight) settle; from then on the
+    // clock stands until the recorder goes on (each wait lasts at most 2 s).
+    std::this_thread::sleep_for(200ms);
+    const double stopped_s = clock.now_s();
+    std::this_thread::sleep_for(800ms);
+    const double still_s = clock.now_s();
+    rec.signal(SIGCONT);
+    EXPECT_EQ(exit_code(graph.wait(300s)), 0) << graph.output();
+    EXPECT_LT(stopped_s, 19.0) << "stopped while the graph ran";
+    EXPECT_LE(still_s - stopped_s, 0.002) << "the clock ran on while the recorder was stopped";
+  }
+  std::this_thread::sleep_for(300ms);
+  rec.signal(SIGINT);
+  const int status = rec.wait(30s);
+  const std::string out = rec.output();
+  EXPECT_EQ(exit_code(status), 0) << out;
+  // From the first message the recorder got (the graph may run a few hundred steps before the
+  // two processes have discovered each other: the recording starts there) to the talker's last.
+  const auto seqs = chatter_sequence(read_all(file));
+  ASSERT_FALSE(seqs.empty()) << out;
+  expect_consecutive(seqs, "the recording");
+  EXPECT_GE(seqs.back(), 19998u) << "20 s at 1 kHz\n" << out;
+  EXPECT_GE(seqs.size(), 10000u) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex("total: [0-9]+ received, [0-9]+ written, 0 lost")))
+      << out;
+}
+
 // Issue 20 section 6: a lockstep graph waits for the recorder (its default): the same run,
 // recorder stopped for a second, loses nothing, and the file has every period.
 TEST(BagRecord, ALockstepGraphWaitsForItsRecorderAndNothingIsLost) {
