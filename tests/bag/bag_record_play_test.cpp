@@ -181,9 +181,11 @@ TEST(BagRecord, RecordsARunningGraphAndReadsTheValuesBack) {
     counts.push_back(static_cast<std::uint64_t>(v.at("data").float_value));
   }
   expect_consecutive(counts, "/talker_count");
-  // The same talker ticks publish both: the value ranges overlap almost entirely.
+  // The same talker ticks publish both: the value ranges overlap almost entirely. The recorder
+  // finds the two writers one after the other (discovery), so the first values may differ by a
+  // few ticks: 3 (15 ms) under ThreadSanitizer once; 20 ticks is 0.1 s of a 2.5 s recording.
   ASSERT_FALSE(counts.empty());
-  EXPECT_LE(std::max(seqs.front(), counts.front()) - std::min(seqs.front(), counts.front()), 2u);
+  EXPECT_LE(std::max(seqs.front(), counts.front()) - std::min(seqs.front(), counts.front()), 20u);
   for (const auto& m : messages) {
     EXPECT_GT(m.publish_time, 0u);
     // Source timestamp (publisher's clock) at or before the time the recorder took the sample
