@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <regex>
@@ -672,6 +673,29 @@ TEST(BagRecord, TheGraphRecorderSplitsItsFileByDurationAndBySizeLosingNothing) {
     EXPECT_GE(seqs.size(), 990u) << output;
     EXPECT_NE(output.find("recording continues in"), std::string::npos) << output;
   }
+  // A split name that exists is another recording: kept (the next free name is used), or with
+  // if_exists fail the graph does not start (not an hour into the recording).
+  {
+    const fs::path stale = temp_dir() / "split_stale_1.mcap";
+    { std::ofstream(stale) << "another recording"; }
+    const fs::path first = temp_dir() / "split_stale.mcap";
+    AvsProcess refused({"launch", source_dir() + "/tests/bag/data/split_recording.yaml",
+                        "out:=" + first.string(), "max_duration_s:=0.25", "if_exists:=fail"},
+                       temp_dir() / "split_stale_fail.log");
+    EXPECT_NE(exit_code(refused.wait(120s)), 0) << refused.output();
+    EXPECT_NE(refused.output().find("split_stale_1.mcap exists (if_exists: fail"),
+              std::string::npos)
+        << refused.output();
+    AvsProcess kept({"launch", source_dir() + "/tests/bag/data/split_recording.yaml",
+                     "out:=" + first.string(), "max_duration_s:=0.25", "if_exists:=keep"},
+                    temp_dir() / "split_stale_keep.log");
+    EXPECT_EQ(exit_code(kept.wait(120s)), 0) << kept.output();
+    std::ifstream in(stale);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "another recording");
+    EXPECT_TRUE(fs::exists(temp_dir() / "split_stale_2.mcap")) << kept.output();
+    EXPECT_NE(kept.output().find("split_stale_1.mcap exists and is kept"), std::string::npos)
+        << kept.output();
+  }
   // The same by size: each file stops growing once it has reached 0.01 MB (its last chunk
   // may take it past).
   {
@@ -694,7 +718,7 @@ TEST(BagRecord, TheRecordCommandSplitsByDurationLosingNothing) {
   ASSERT_TRUE(graph.started());
   std::this_thread::sleep_for(1500ms);
   const fs::path first = temp_dir() / "split_cli.mcap";
-  AvsProcess rec({"bag", "record", "/chatter", "-o", first.string(), "--duration", "1.6",
+  AvsProcess rec({"bag", "record", "/chatter", "-o", first.string(), "--duration", "3",
                   "--max-duration", "0.5"},
                  temp_dir() / "split_cli_record.log");
   ASSERT_EQ(exit_code(rec.wait(30s)), 0) << rec.output();
@@ -737,6 +761,7 @@ TEST(BagRecord, ALockstepTalkerWaitsForItsStoppedRecorder) {
     const auto give_up = std::chrono::steady_clock::now() + 120s;
     while (clock.now_s() < 5.0 && std::chrono::steady_clock::now() < give_up)
       std::this_thread::sleep_for(5ms);
+    ASSERT_GE(clock.now_s(), 5.0) << "no /clock seen: nothing below would test the wait";
     rec.signal(SIGSTOP);
     // The steps already under way (and the /clock samples in flight) settle; from then on the
     // clock stands until the recorder goes on (each wait lasts at most 2 s).

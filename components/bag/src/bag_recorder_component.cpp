@@ -95,6 +95,22 @@ class BagRecorderComponent final : public runtime::Component {
           runtime::dds::EndpointQos::from_profile(qos)};
       channel.offered_qos = offered_qos_yaml(offered);
     }
+    if (split_.max_size_bytes > 0 || split_.max_duration_s > 0) {
+      // The split names are checked now as well: a stale <stem>_1.mcap fails the start, not the
+      // recording an hour in (fail), or is said to be overwritten when reached (overwrite).
+      std::error_code ec;
+      const std::string second = split_path(file_, 1).string();
+      if (std::filesystem::exists(second, ec) && if_exists_ == "fail")
+        throw runtime::Error("bag_recorder: " + second +
+                             " exists (if_exists: fail; the file "
+                             "after " +
+                             file_ + " when it splits)");
+      if (std::filesystem::exists(second, ec) && if_exists_ == "overwrite")
+        log().warn(
+            "bag_recorder: ", second,
+            " (and maybe more <stem>_N.mcap) exist from an "
+            "earlier recording: each is overwritten when this one reaches it, the rest stay");
+    }
     open_file();
     log().info("recording ", channels_.size(), " topic(s) into ", file_);
     if (split_.max_size_bytes > 0 || split_.max_duration_s > 0) {
@@ -150,12 +166,24 @@ class BagRecorderComponent final : public runtime::Component {
           "add channel " + name);
     }
     file_start_ns_ = -1;
+    std::lock_guard lock(mutex_);
+    written_before_file_ = written_;
   }
 
-  /// Closes the open file (complete, with its summary) and continues in the next one.
+  /// Closes the open file (complete, with its summary) and continues in the next one. On a
+  /// failure the recording stops (write() says so); the messages the closed file lacks are
+  /// counted as not written.
   mcap::Status next_file() {
-    mcap::Status status = writer_.close();
-    if (!status.ok()) return status;
+    if (const mcap::Status closed = writer_.close(); !closed.ok()) {
+      std::lock_guard lock(mutex_);
+      settle_open_file();
+      return {closed.code(),
+              "close " + current_file_ + " to start the next file: " + closed.to_string()};
+    }
+    {
+      std::lock_guard lock(mutex_);
+      settle_open_file();  // complete: nothing to move, but the next file counts from here
+    }
     const std::string closed = current_file_;
     // Never over another recording: with if_exists keep a name that exists is skipped.
     namespace fs = std::filesystem;
@@ -163,8 +191,9 @@ class BagRecorderComponent final : public runtime::Component {
     std::error_code ec;
     for (; if_exists_ != "overwrite" && fs::exists(split_path(file_, index), ec); ++index) {
       if (if_exists_ == "fail" || index >= file_index_ + 100000) {
-        return {mcap::StatusCode::io_error,
-                split_path(file_, index).string() + " exists (if_exists: " + if_exists_ + ")"};
+        return {mcap::StatusCode::io_error, "start the file after " + closed + ": " +
+                                                split_path(file_, index).string() +
+                                                " exists (if_exists: " + if_exists_ + ")"};
       }
       log().warn("bag_recorder: ", split_path(file_, index).string(),
                  " exists and is kept (if_exists: keep); skipping to the next name");
@@ -177,10 +206,22 @@ class BagRecorderComponent final : public runtime::Component {
     try {
       open_file();
     } catch (const std::exception& e) {
-      return {mcap::StatusCode::io_error, e.what()};
+      return {mcap::StatusCode::io_error, std::string("start the next file: ") + e.what()};
     }
     log().info("closed ", closed, ", recording continues in ", current_file_);
-    return status;
+    return {};
+  }
+
+  /// The open file's messages that did not reach it (a failed write or close loses the chunk
+  /// being filled and the queued ones) move from written_ to not_written_; from here on the
+  /// open file counts anew. Under mutex_.
+  void settle_open_file() {
+    const std::uint64_t in_this_file = written_ - written_before_file_;
+    const std::uint64_t lost =
+        in_this_file - std::min(in_this_file, writer_.statistics().messages_in_file);
+    written_ -= lost;
+    not_written_ += lost;
+    written_before_file_ = written_;
   }
 
   /// A write the file refuses (disk full, I/O error) ends the recording, loudly, and only the
@@ -200,6 +241,7 @@ class BagRecorderComponent final : public runtime::Component {
       status = next_file();
       chunk_start_ns_ = -1;
     }
+    const bool split_failed = !status.ok();
     if (file_start_ns_ < 0) file_start_ns_ = static_cast<std::int64_t>(now);
     if (status.ok()) status = writer_.write(channel.id, now, now, cdr);
     if (status.ok() && max_chunk_age_ns_ > 0) {
@@ -217,24 +259,28 @@ class BagRecorderComponent final : public runtime::Component {
       return;
     }
     ++not_written_;
-    failure_ = "write " + channel.topic + ": " + status.to_string();
+    failure_ =
+        split_failed ? status.to_string() : "write " + channel.topic + ": " + status.to_string();
     log().error("bag_recorder: ", current_file_, ": ", failure_, ": recording STOPPED after ",
-                written_,
-                " message(s); the rest of the graph goes on; the file is readable up to its last "
-                "complete chunk (`avs bag repair` gives it a summary)");
+                written_, " message(s); the rest of the graph goes on",
+                split_failed ? ""
+                             : "; the file is readable up to its last complete chunk "
+                               "(`avs bag repair` gives it a summary)");
   }
 
   void close() {
-    if (!writer_.is_open()) return;
-    const mcap::Status status = writer_.close();
+    if (closed_) return;  // on_shutdown, then the destructor
+    closed_ = true;
+    const mcap::Status status = writer_.is_open() ? writer_.close() : mcap::Status::success();
     std::lock_guard lock(mutex_);
     if (!failure_.empty()) {
-      // What the file holds: the chunks written before the failure; the messages of the
-      // chunk being filled then are lost with it.
-      const std::uint64_t in_file = writer_.statistics().messages_in_file;
-      log().error("bag_recorder: ", current_file_, ": ", in_file, " message(s) in the file, ",
-                  not_written_ + written_ - std::min(written_, in_file), " NOT written (", failure_,
-                  ")");
+      // What the files hold: every file before the failure, and the open one's complete chunks;
+      // the messages of the chunk being filled then are lost with it.
+      settle_open_file();
+      log().error("bag_recorder: ", file_, file_index_ > 0 ? " .. " + current_file_ : std::string(),
+                  ": ", written_,
+                  file_index_ > 0 ? " message(s) in the files, " : " message(s) in the file, ",
+                  not_written_, " NOT written (", failure_, ")");
     } else if (!status.ok()) {
       log().error("bag_recorder: ", current_file_, ": close: ", status.to_string(), " (", written_,
                   " message(s) written; `avs bag repair` rebuilds the summary)");
@@ -286,8 +332,10 @@ class BagRecorderComponent final : public runtime::Component {
   std::map<std::string, Channel> channels_;
   mutable std::mutex mutex_;  ///< the counts and failure_ are read by the diagnostics timer
   std::uint64_t written_ = 0;
-  std::uint64_t not_written_ = 0;  ///< after a failed write
-  std::string failure_;            ///< the write that failed; empty while recording
+  std::uint64_t not_written_ = 0;          ///< after a failed write
+  std::uint64_t written_before_file_ = 0;  ///< written_ when the open file started
+  bool closed_ = false;
+  std::string failure_;  ///< the write that failed; empty while recording
 };
 
 AVS_REGISTER_COMPONENT(BagRecorderComponent);
