@@ -779,8 +779,9 @@ TEST(BagRecord, ALockstepTalkerWaitsForItsStoppedRecorder) {
   const int status = rec.wait(30s);
   const std::string out = rec.output();
   EXPECT_EQ(exit_code(status), 0) << out;
-  // From the first message the recorder got (the graph may run a few hundred steps before the
-  // two processes have discovered each other: the recording starts there) to the talker's last.
+  // From the first message the recorder got (the graph may run thousands of steps, 5760 once,
+  // before the two processes have discovered each other: the recording starts there, docs/bag.md
+  // "Known limit") to the talker's last.
   const auto seqs = chatter_sequence(read_all(file));
   ASSERT_FALSE(seqs.empty()) << out;
   expect_consecutive(seqs, "the recording");

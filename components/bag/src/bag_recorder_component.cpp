@@ -95,7 +95,7 @@ class BagRecorderComponent final : public runtime::Component {
           runtime::dds::EndpointQos::from_profile(qos)};
       channel.offered_qos = offered_qos_yaml(offered);
     }
-    if (split_.max_size_bytes > 0 || split_.max_duration_s > 0) {
+    if (split_.enabled()) {
       // The split names are checked now as well: a stale <stem>_1.mcap fails the start, not the
       // recording an hour in (fail), or is said to be overwritten when reached (overwrite).
       std::error_code ec;
@@ -113,7 +113,7 @@ class BagRecorderComponent final : public runtime::Component {
     }
     open_file();
     log().info("recording ", channels_.size(), " topic(s) into ", file_);
-    if (split_.max_size_bytes > 0 || split_.max_duration_s > 0) {
+    if (split_.enabled()) {
       std::ostringstream when;
       if (split_.max_size_bytes > 0)
         when << "once one reaches " << ctx.param<double>("max_size_mb") << " MB";
@@ -235,7 +235,7 @@ class BagRecorderComponent final : public runtime::Component {
     }
     const auto now = static_cast<mcap::Timestamp>(std::max<std::int64_t>(0, context().now().ns));
     mcap::Status status;
-    if (file_start_ns_ >= 0 &&
+    if (split_.enabled() && file_start_ns_ >= 0 &&
         split_.starts_new_file(writer_.statistics().file_bytes,
                                static_cast<std::uint64_t>(file_start_ns_), now)) {
       status = next_file();

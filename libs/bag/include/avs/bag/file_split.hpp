@@ -14,6 +14,9 @@ struct FileSplit {
   std::uint64_t max_size_bytes = 0;  ///< 0: no size limit
   double max_duration_s = 0;         ///< of log time; 0: no duration limit
 
+  /// Whether either limit is set (else one file).
+  [[nodiscard]] bool enabled() const { return max_size_bytes > 0 || max_duration_s > 0; }
+
   /// Whether the message at log_time_ns starts a new file: the open file (file_bytes written,
   /// its first message at file_start_ns) reached the size or would cover the duration.
   [[nodiscard]] bool starts_new_file(std::uint64_t file_bytes, std::uint64_t file_start_ns,
