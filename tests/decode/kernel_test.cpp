@@ -4,11 +4,14 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "avs/decode/triangulation.hpp"
 #include "rolling_kernel.hpp"
+#include "subcode.hpp"
 
 namespace avs::decode::detail {
 namespace {
@@ -90,7 +93,8 @@ TEST(PairKernel, AllInstructionSetsAgree) {
 }
 
 TEST(PairKernel, BitsOnlyUpdateAgreesAcrossInstructionSets) {
-  // depth_m = null (the window is not complete yet): Gray words and flags only.
+  // depth_m = null (the window is not complete yet): Gray words and flags only; with codes (the
+  // sub-code refinement's input) the binary codes as well, as codes_from_gray gives them.
   const int width = 77, height = 5, pixels = width * height;  // odd width: the scalar tail too
   std::mt19937 random(4);
   std::uniform_int_distribution<int> byte(0, 255), word(0, 511);
@@ -100,14 +104,18 @@ TEST(PairKernel, BitsOnlyUpdateAgreesAcrossInstructionSets) {
     positive[i] = static_cast<std::uint8_t>(byte(random));
     negative[i] = static_cast<std::uint8_t>(byte(random));
     gray[i] = static_cast<std::uint16_t>(word(random));
-    valid[i] = static_cast<std::uint16_t>(word(random));
+    valid[i] = static_cast<std::uint16_t>(word(random) | (i % 3 == 0 ? 511 : 0));
   }
-  for (bool correction : {true, false}) {
+  constexpr int kCodeCount = 400;  // below 2^9: some complete words are no code
+  for (const auto& [correction, with_codes] :
+       {std::pair{true, false}, std::pair{false, false}, std::pair{true, true}}) {
     std::vector<std::vector<std::uint16_t>> grays, valids;
+    std::vector<std::vector<std::int16_t>> codes;
     for (KernelIsa isa : {KernelIsa::kScalar, KernelIsa::kSse2, KernelIsa::kAvx2}) {
       if (isa == KernelIsa::kAvx2 && best_kernel_isa() != KernelIsa::kAvx2) continue;
       grays.push_back(gray);
       valids.push_back(valid);
+      codes.emplace_back(pixels, std::int16_t{-7});
       PairUpdateArgs a;
       a.positive = positive.data();
       a.positive_stride = width;
@@ -121,13 +129,33 @@ TEST(PairKernel, BitsOnlyUpdateAgreesAcrossInstructionSets) {
       a.threshold_psi = 10;
       a.code_correction = correction;
       a.full_mask = 511;
+      if (with_codes) {
+        a.codes = codes.back().data();
+        a.code_count = kCodeCount;
+      }
       update_pair(a, isa);
     }
     EXPECT_NE(grays[0], gray);
     for (std::size_t j = 1; j < grays.size(); ++j) {
       EXPECT_EQ(grays[j], grays[0]) << "isa " << j;
       EXPECT_EQ(valids[j], valids[0]) << "isa " << j;
+      EXPECT_EQ(codes[j], codes[0]) << "isa " << j;
     }
+    if (!with_codes) {
+      EXPECT_EQ(codes[0], std::vector<std::int16_t>(pixels, -7)) << "no codes asked, none written";
+      continue;
+    }
+    std::vector<std::int16_t> expected(pixels);
+    codes_from_gray(grays[0].data(), valids[0].data(), 511, kCodeCount, expected.data(), pixels);
+    EXPECT_EQ(codes[0], expected);
+    int coded = 0, complete_but_too_large = 0;
+    for (int i = 0; i < pixels; ++i) {
+      coded += expected[i] >= 0 ? 1 : 0;
+      complete_but_too_large +=
+          valids[0][i] == 511 && gray_to_binary(grays[0][i]) >= kCodeCount ? 1 : 0;
+    }
+    EXPECT_GT(coded, 0);
+    EXPECT_GT(complete_but_too_large, 0) << "the code-count bound is exercised";
   }
 }
 

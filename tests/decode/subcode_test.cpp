@@ -159,8 +159,8 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
   std::mt19937 random(11);
   int narrow_runs = 0;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  // Codes of a few hundred, then (largest < 0) codes up to the largest the 16-bit sums of that
-  // half window allow, (h + 1)^2 x largest < 2^15, so that those sums come near their limits.
+  // Codes of a few hundred, then (half > 0) codes up to the largest the 16-bit sums of that
+  // half window allow, (2h + 1)(largest + 1) < 2^15, so that those sums come near their limits.
   struct Field {
     int width, height, half;
   };
@@ -168,7 +168,7 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
                             Field{37, 60, 4}, Field{46, 60, 7}, Field{37, 60, 16}}) {
     const int width = field.width;
     const int height = field.height;
-    const int largest = field.half > 0 ? 32767 / ((field.half + 1) * (field.half + 1)) : 0;
+    const int largest = field.half > 0 ? 32767 / (2 * field.half + 1) - 1 : 0;
     std::vector<std::int16_t> codes(static_cast<std::size_t>(width) * height);
     for (int x = 0; x < width; ++x) {
       double f = largest > 0 ? largest - 60.0 + x : 40.0 + 3.0 * x;
@@ -244,6 +244,13 @@ TEST(SubcodeRefiner, RejectsBadParameters) {
   EXPECT_THROW(SubcodeRefiner({kWidth, kHeight, 0, 2}), std::invalid_argument);
   EXPECT_THROW(SubcodeRefiner({kWidth, kHeight, 17, 2}), std::invalid_argument);
   EXPECT_THROW(SubcodeRefiner({kWidth, kHeight, 4, -1}), std::invalid_argument);
+  SubcodeRefiner refiner({kWidth, kHeight, 4, 2});
+  std::vector<std::int16_t> codes(kWidth * kHeight, 3);
+  std::vector<float> row(kWidth);
+  EXPECT_THROW(
+      refiner.refine(codes.data(), row.data(), nullptr, SubcodeRefiner::RefinedRows::kOneRowForAll),
+      std::invalid_argument)
+      << "one row for all without a sink would lose every row but the last";
 }
 
 // The AVX2 triangulation (8 pixels, plane rows loaded and transposed) equals the plain loop bit
@@ -277,6 +284,23 @@ TEST(SubcodeTriangulation, InstructionSetsGiveBitIdenticalDepths) {
       EXPECT_EQ(std::memcmp(plain.data(), avx2.data(), plain.size() * sizeof(float)), 0)
           << n << " pixels, window " << min_m << ".." << max_m << " m";
     }
+  }
+  // Row by row with separable rays (the decoder's way for a camera without distortion): the
+  // same depths as with the per-pixel rays.
+  ASSERT_NE(table.column_ray_x(), nullptr);
+  std::vector<float> per_pixel(static_cast<std::size_t>(pixels));
+  triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), 0.3f, 1.5f,
+                      per_pixel.data(), pixels, KernelIsa::kScalar);
+  for (const KernelIsa isa : {KernelIsa::kScalar, best_kernel_isa()}) {
+    std::vector<float> by_row(static_cast<std::size_t>(pixels));
+    for (int y = 0; y < g.camera.height; ++y) {
+      const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(y) * g.camera.width;
+      triangulate_subcode_row(refined.data() + offset, planes, table.column_ray_x(),
+                              table.row_ray_y()[y], 0.3f, 1.5f, by_row.data() + offset,
+                              g.camera.width, isa);
+    }
+    EXPECT_EQ(std::memcmp(per_pixel.data(), by_row.data(), by_row.size() * sizeof(float)), 0)
+        << kernel_isa_name(isa);
   }
 }
 

@@ -51,10 +51,9 @@ std::unique_ptr<detail::SubcodeRefiner> make_refiner(const DecoderConfig& c) {
     throw std::invalid_argument("rolling decoder: subcode_steps " +
                                 std::to_string(c.subcode_steps) + " outside 1..256");
   }
-  return std::make_unique<detail::SubcodeRefiner>(
-      detail::SubcodeParams{c.geometry.camera.width, c.geometry.camera.height,
-                            c.subcode_half_window, c.subcode_max_jump,
-                            c.geometry.layout.code_count});
+  return std::make_unique<detail::SubcodeRefiner>(detail::SubcodeParams{
+      c.geometry.camera.width, c.geometry.camera.height, c.subcode_half_window, c.subcode_max_jump,
+      c.geometry.layout.code_count});
 }
 
 /// Depth from fractional codes through the sub-code planes (NaN codes give NaN), all pixels.
@@ -72,11 +71,17 @@ class RowTriangulator final : public detail::SubcodeRefiner::RowSink {
       : table_(table), c_(c), depth_out_(depth_out), width_(width) {}
   void row_done(int y, const float* refined_row) override {
     const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(y) * width_;
-    detail::triangulate_subcode(
-        refined_row,
-        {table_.subcode_planes(), table_.subcode_steps(), table_.subcode_plane_count()},
-        table_.ray_x() + offset, table_.ray_y() + offset, c_.min_depth_m, c_.max_depth_m,
-        depth_out_ + offset, width_);
+    const detail::SubcodePlanes planes{table_.subcode_planes(), table_.subcode_steps(),
+                                       table_.subcode_plane_count()};
+    if (table_.column_ray_x() != nullptr) {  // separable rays: 8 bytes per pixel less to read
+      detail::triangulate_subcode_row(refined_row, planes, table_.column_ray_x(),
+                                      table_.row_ray_y()[y], c_.min_depth_m, c_.max_depth_m,
+                                      depth_out_ + offset, width_);
+      return;
+    }
+    detail::triangulate_subcode(refined_row, planes, table_.ray_x() + offset,
+                                table_.ray_y() + offset, c_.min_depth_m, c_.max_depth_m,
+                                depth_out_ + offset, width_);
   }
 
  private:
@@ -142,7 +147,7 @@ RollingDecoder::RollingDecoder(DecoderConfig config)
   refiner_ = make_refiner(config_);
   if (refiner_) {
     codes_.assign(pixels, -1);
-    refined_codes_.assign(pixels, kNan);
+    refined_row_.assign(static_cast<std::size_t>(width_), kNan);
   }
 }
 
@@ -296,6 +301,10 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
     args.min_depth_m = config_.min_depth_m;
     args.max_depth_m = config_.max_depth_m;
   }
+  if (refiner_) {  // the codes for the refinement come out of the same pass
+    args.codes = codes_.data();
+    args.code_count = config_.geometry.layout.code_count;
+  }
   detail::update_pair(args);
 
   const std::size_t pixels = depth_m_.size();
@@ -319,11 +328,10 @@ DecodeResult RollingDecoder::apply_pair(const ImageView8& positive, const ImageV
 }
 
 void RollingDecoder::refine_depth(float* depth_out) {
-  const auto full = static_cast<std::uint16_t>((1u << bit_count_) - 1u);
-  detail::codes_from_gray(gray_.data(), valid_.data(), full, config_.geometry.layout.code_count,
-                          codes_.data(), static_cast<int>(codes_.size()));
+  // codes_: from update_pair, with the bits of this pair.
   RowTriangulator triangulate_rows(table_, config_, depth_out, width_);
-  refiner_->refine(codes_.data(), refined_codes_.data(), &triangulate_rows);
+  refiner_->refine(codes_.data(), refined_row_.data(), &triangulate_rows,
+                   detail::SubcodeRefiner::RefinedRows::kOneRowForAll);
 }
 
 void RollingDecoder::fill_point_map() {

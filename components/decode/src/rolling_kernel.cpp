@@ -13,12 +13,15 @@ namespace avs::decode::detail {
 namespace {
 
 // One image row; written as a branch-free loop over plain arrays so that the compiler
-// vectorises it (the plane look-up is a gather of 3 floats).
-template <bool kWithDepth, bool kRowRay = false>
+// vectorises it (the plane look-up is a gather of 3 floats). kCodes (without depth): the binary
+// codes of the row as well (PairUpdateArgs::codes, the row at the same offset as `gray`).
+template <bool kWithDepth, bool kRowRay = false, bool kCodes = false>
 void update_row(const std::uint8_t* __restrict positive, const std::uint8_t* __restrict negative,
                 std::uint16_t* __restrict gray, std::uint16_t* __restrict valid,
                 float* __restrict depth, const float* __restrict ray_x,
                 const float* __restrict ray_y, const PairUpdateArgs& a, int begin = 0) {
+  static_assert(!(kWithDepth && kCodes));
+  std::int16_t* __restrict codes = kCodes ? a.codes + (gray - a.gray) : nullptr;
   const int position = a.bit_position;
   const int psi = a.threshold_psi;
   const auto bit_mask = static_cast<std::uint16_t>(1u << position);
@@ -47,12 +50,16 @@ void update_row(const std::uint8_t* __restrict positive, const std::uint8_t* __r
     v = static_cast<std::uint16_t>((v & ~bit_mask) | (known << position));
     gray[x] = g;
     valid[x] = v;
-    if constexpr (!kWithDepth) continue;
+    if constexpr (!kWithDepth && !kCodes) continue;
     // Eq. 3 word -> binary code.
     std::uint16_t b = static_cast<std::uint16_t>(g ^ (g >> 1));
     b = static_cast<std::uint16_t>(b ^ (b >> 2));
     b = static_cast<std::uint16_t>(b ^ (b >> 4));
     b = static_cast<std::uint16_t>(b ^ (b >> 8));
+    if constexpr (kCodes) {
+      codes[x] = static_cast<std::int16_t>(v == full && b < a.code_count ? b : -1);
+      continue;
+    }
     const int index = v == full ? b : invalid;
     const float* plane = planes + 4 * index;
     const float z = 1.0f / (plane[0] * ray_x[x] + plane[1] * ray_y[kRowRay ? 0 : x] + plane[2]);
@@ -142,8 +149,9 @@ void update_row_sse2(const std::uint8_t* __restrict positive,
 
 // AVX2 (chosen at run time): the 16-bit steps on 16 pixels at once, then the depth of each
 // half through load_planes8 (plane_lookup_avx2.hpp).
-// kWithDepth = false: the bits only (while the window is incomplete).
-template <bool kWithDepth, bool kRowRay>
+// kWithDepth = false: the bits only (while the window is incomplete), with kCodes the binary
+// codes as well (update_row).
+template <bool kWithDepth, bool kRowRay, bool kCodes = false>
 __attribute__((target("avx2"))) void update_row_avx2(
     const std::uint8_t* __restrict positive, const std::uint8_t* __restrict negative,
     std::uint16_t* __restrict gray, std::uint16_t* __restrict valid, float* __restrict depth,
@@ -162,6 +170,9 @@ __attribute__((target("avx2"))) void update_row_avx2(
   const __m256 zmax = _mm256_set1_ps(a.max_depth_m);
   const __m256 nan = _mm256_set1_ps(std::numeric_limits<float>::quiet_NaN());
   const float* planes = a.planes;
+  std::int16_t* __restrict codes = kCodes ? a.codes + (gray - a.gray) : nullptr;
+  const __m256i code_count = _mm256_set1_epi16(static_cast<short>(a.code_count));
+  const __m256i minus_one = _mm256_set1_epi16(-1);
   // Depth of the 8 pixels from x on, with plane indices `index` (8 x 16 bit).
   const auto depth8 = [&](__m128i index, int x) __attribute__((target("avx2"))) {
     const auto lo = static_cast<std::uint64_t>(_mm_cvtsi128_si64(index));
@@ -210,6 +221,11 @@ __attribute__((target("avx2"))) void update_row_avx2(
     b = _mm256_xor_si256(b, _mm256_srli_epi16(b, 4));
     b = _mm256_xor_si256(b, _mm256_srli_epi16(b, 8));
     const __m256i ok = _mm256_cmpeq_epi16(v, full);
+    if constexpr (kCodes) {  // b < 2^15 (at most 15 bits): a signed comparison
+      const __m256i code_ok = _mm256_and_si256(ok, _mm256_cmpgt_epi16(code_count, b));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes + x),
+                          _mm256_blendv_epi8(minus_one, b, code_ok));
+    }
     const __m256i index =
         _mm256_or_si256(_mm256_and_si256(ok, b), _mm256_andnot_si256(ok, invalid));
     if constexpr (kWithDepth) {
@@ -217,7 +233,11 @@ __attribute__((target("avx2"))) void update_row_avx2(
       depth8(_mm256_extracti128_si256(index, 1), x + 8);
     }
   }
-  update_row<kWithDepth, kRowRay>(positive, negative, gray, valid, depth, ray_x, ray_y, a, x);
+  // Clean upper halves before the tail and the (SSE) caller: GCC 12 did not always insert the
+  // vzeroupper (subcode.cpp, triangulate_subcode_avx2).
+  _mm256_zeroupper();
+  update_row<kWithDepth, kRowRay, kCodes>(positive, negative, gray, valid, depth, ray_x, ray_y, a,
+                                          x);
 }
 #endif
 
@@ -258,15 +278,18 @@ void update_pair(const PairUpdateArgs& a, KernelIsa isa) {
     const auto* positive = a.positive + y * a.positive_stride;
     const auto* negative = a.negative + y * a.negative_stride;
     if (a.depth_m == nullptr) {
+      const bool codes = a.codes != nullptr;
 #if defined(AVS_DECODE_X86)
       if (isa == KernelIsa::kAvx2) {
-        update_row_avx2<false, false>(positive, negative, a.gray + row, a.valid + row, nullptr,
-                                      nullptr, nullptr, a);
+        (codes ? update_row_avx2<false, false, true>
+               : update_row_avx2<false, false, false>)(positive, negative, a.gray + row,
+                                                       a.valid + row, nullptr, nullptr, nullptr, a);
         continue;
       }
 #endif
-      update_row<false>(positive, negative, a.gray + row, a.valid + row, nullptr, nullptr, nullptr,
-                        a);
+      (codes ? update_row<false, false, true>
+             : update_row<false, false, false>)(positive, negative, a.gray + row, a.valid + row,
+                                                nullptr, nullptr, nullptr, a, 0);
       continue;
     }
     float* depth = a.depth_m + row;

@@ -21,6 +21,10 @@ struct PairUpdateArgs {
   std::uint16_t full_mask = 0;  ///< (1 << n) - 1
   /// Depth output; null to update the bits only.
   float* depth_m = nullptr;
+  /// Without depth output: the binary code of every pixel as well (width * height, -1 unless
+  /// every bit is known and the code is below code_count), for the sub-code refinement.
+  std::int16_t* codes = nullptr;
+  int code_count = 0;
   const float* ray_x = nullptr;
   const float* ray_y = nullptr;
   /// Optional, both or neither: separable rays (DepthTable::column_ray_x / row_ray_y), used

@@ -22,15 +22,15 @@ SubcodeRefiner::SubcodeRefiner(SubcodeParams params, KernelIsa isa) : params_(pa
   // 16-bit factors of the AVX2 steps' products (vpmaddwd, vpmullw).
   params_.max_jump = std::min(params_.max_jump, 32767);
   const auto w = static_cast<std::size_t>(params_.width);
-  // The 16-bit sums are exact (wrapping arithmetic, exact at every output) when the largest sums
-  // fit: sc <= (2h + 1) c, |scd| and the leaving row's term within (h + 1)^2 c for c = the largest
-  // code; the rows (y, and the gap before a discontinuity times max_jump) fit as well.
+  // The 16-bit sums (count, code, discontinuities) are exact (wrapping arithmetic, exact at
+  // every output) when the largest values fit: sc <= (2h + 1) c and the mean's clamp bound
+  // (2h + 1)(c + 1) for c = the largest code; the rows (y, and the gap before a discontinuity
+  // times max_jump) fit as well.
   const int h = params_.half_window;
-  const long largest_code = static_cast<long>(params_.code_count) - 1;
-  narrow_ = params_.code_count > 0 && static_cast<long>(h + 1) * (h + 1) * largest_code < 32768 &&
+  narrow_ = params_.code_count > 0 && static_cast<long>(2 * h + 1) * params_.code_count < 32768 &&
             static_cast<long>(2 * h + 2) * params_.max_jump < 32768 && params_.height < 32768;
   if (narrow_) {
-    for (auto* v : {&n16_, &sd16_, &sdd16_, &sc16_, &scd16_, &jumps16_, &previous_y16_}) {
+    for (auto* v : {&n16_, &sc16_, &jumps16_, &previous_y16_}) {
       v->assign(w, 0);
     }
   }
@@ -42,7 +42,7 @@ SubcodeRefiner::SubcodeRefiner(SubcodeParams params, KernelIsa isa) : params_(pa
   jumps_.assign(w, 0);
   previous_.assign(w, 0);
   previous_y_.assign(w, 0);
-  jump_.assign(w * static_cast<std::size_t>(params_.height), 0);
+  jump_.assign(w * static_cast<std::size_t>(2 * params_.half_window + 2), 0);
 }
 
 namespace {
@@ -67,6 +67,13 @@ struct Sums {
   T* __restrict jumps;
 };
 
+// The sums the 16-column AVX2 step keeps per column (16 bits): count, code, discontinuities.
+struct NarrowSums {
+  std::int16_t* __restrict n;
+  std::int16_t* __restrict sc;
+  std::int16_t* __restrict jumps;
+};
+
 struct StepArgs {
   const std::int16_t* entering;  ///< row y_in
   std::uint8_t* entering_jump;
@@ -79,8 +86,13 @@ struct StepArgs {
   Sums<std::int32_t> s;
   int width, y_in, d_in, d_out, reach, max_jump;
   /// The 16-bit sums and previous rows when they are exact (SubcodeRefiner), else null.
-  const Sums<std::int16_t>* narrow;
+  const NarrowSums* narrow;
   std::int16_t* previous_y16;
+  /// The window's rows about y0 (kOutput): the first (clipped to the image) and how many, and
+  /// the first one's offset d = y - y0.
+  const std::int16_t* window_first = nullptr;
+  int window_rows = 0;
+  int window_first_d = 0;
 };
 
 // One step of the window for output row y0, in one pass over the columns (the sums stay in
@@ -352,6 +364,7 @@ __attribute__((target("avx2"))) void window_step_avx2(const StepArgs& a) {
     store32(s.jumps + x, w.jumps);
     if constexpr (kOutput) _mm256_storeu_ps(a.out + x, fit8(w, load16(a.row + x), k));
   }
+  _mm256_zeroupper();  // see triangulate_subcode_avx2
   window_step_plain<kAdd, kRemove, kOutput>(a, x);
 }
 
@@ -372,43 +385,46 @@ AVS_AVX2_INLINE __m256i widen_high(__m256i v) {
   return _mm256_cvtepi16_epi32(_mm256_extracti128_si256(v, 1));
 }
 
-// window_step_plain on 16 columns at once with the 16-bit sums (StepArgs::narrow): the same
-// additions modulo 2^16, exact whenever a result is used (SubcodeRefiner's bounds); the line fit
-// on the sums widened to 32 bits by fit8. Half the instructions per column of the 8-column step.
+// The offset sums sd, sdd, scd of 8 columns (c: their codes widened, 16 bits in the low half
+// of each lane) from the window's rows: exact integers, equal to the running sums.
+struct OffsetSums8 {
+  __m256i sd, sdd, scd;
+};
+AVS_AVX2_INLINE void add_row8(OffsetSums8& o, __m256i c, __m256i d, __m256i dd,
+                              const WindowConstants8& k) {
+  const __m256i valid = _mm256_cmpgt_epi32(c, k.minus_one);
+  o.sd = _mm256_add_epi32(o.sd, _mm256_and_si256(valid, d));
+  o.sdd = _mm256_add_epi32(o.sdd, _mm256_and_si256(valid, dd));
+  o.scd = _mm256_add_epi32(o.scd, _mm256_mullo_epi32(_mm256_and_si256(valid, c), d));
+}
+
+// window_step_plain on 16 columns at once with 16-bit sums of count, code and discontinuities
+// (StepArgs::narrow): the same additions modulo 2^16, exact whenever a result is used
+// (SubcodeRefiner's bounds). A block whose fitted columns all have the complete window (the
+// common case) needs no more: the fit is the window's mean. The other blocks (near invalid
+// pixels and the image's top and bottom) take their offset sums sd, sdd, scd from the window's
+// rows, in 32 bits, and the line fit of fit8: no running offset sums to move for every block.
 template <bool kAdd, bool kRemove, bool kOutput>
 __attribute__((target("avx2"))) void window_step_avx2_narrow(const StepArgs& a) {
-  const Sums<std::int16_t>& s = *a.narrow;
+  const NarrowSums& s = *a.narrow;
   const WindowConstants8 k(a.d_in, a.d_out, a.reach, a.max_jump);
   const __m256i zero = _mm256_setzero_si256();
   const __m256i one = _mm256_set1_epi16(1);
   const __m256i minus_one = _mm256_set1_epi16(-1);
   const __m256i two = word(2);
   const __m256i full = word(a.reach + 1);
-  const __m256i d_in = word(a.d_in);
-  const __m256i dd_in = word(a.d_in * a.d_in);
-  const __m256i d_out = word(a.d_out);
-  const __m256i dd_out = word(a.d_out * a.d_out);
+  const __m256 full_f = _mm256_set1_ps(static_cast<float>(a.reach + 1));
   const __m256i y_in = word(a.y_in);
   const __m256i beyond = word(a.reach + 1);
   const __m256i max_jump = word(a.max_jump);
   int x = 0;
   for (; x + 16 <= a.width; x += 16) {
-    __m256i n = load(s.n + x), sd = load(s.sd + x), sdd = load(s.sdd + x), sc = load(s.sc + x),
-            scd = load(s.scd + x), jumps = load(s.jumps + x);
-    if constexpr (kOutput) {  // as shift8
-      sdd = _mm256_sub_epi16(_mm256_add_epi16(sdd, n), _mm256_slli_epi16(sd, 1));
-      sd = _mm256_sub_epi16(sd, n);
-      scd = _mm256_sub_epi16(scd, sc);
-    }
+    __m256i n = load(s.n + x), sc = load(s.sc + x), jumps = load(s.jumps + x);
     if constexpr (kRemove) {  // as remove8
       const __m256i c = load(a.leaving + x);
       const __m256i valid = _mm256_cmpgt_epi16(c, minus_one);
-      const __m256i vc = _mm256_and_si256(valid, c);
       n = _mm256_add_epi16(n, valid);
-      sd = _mm256_sub_epi16(sd, _mm256_and_si256(valid, d_out));
-      sdd = _mm256_sub_epi16(sdd, _mm256_and_si256(valid, dd_out));
-      sc = _mm256_sub_epi16(sc, vc);
-      scd = _mm256_sub_epi16(scd, _mm256_mullo_epi16(vc, d_out));
+      sc = _mm256_sub_epi16(sc, _mm256_and_si256(valid, c));
       jumps = _mm256_sub_epi16(jumps, _mm256_cvtepu8_epi16(_mm_loadu_si128(
                                           reinterpret_cast<const __m128i*>(a.leaving_jump + x))));
     }
@@ -430,43 +446,58 @@ __attribute__((target("avx2"))) void window_step_avx2_narrow(const StepArgs& a) 
       store(a.previous_y16 + x,
             _mm256_add_epi16(previous_y,
                              _mm256_and_si256(valid, _mm256_sub_epi16(y_in, previous_y))));
-      const __m256i vc = _mm256_and_si256(valid, c);
       n = _mm256_sub_epi16(n, valid);
-      sd = _mm256_add_epi16(sd, _mm256_and_si256(valid, d_in));
-      sdd = _mm256_add_epi16(sdd, _mm256_and_si256(valid, dd_in));
-      sc = _mm256_add_epi16(sc, vc);
-      scd = _mm256_add_epi16(scd, _mm256_mullo_epi16(vc, d_in));
+      sc = _mm256_add_epi16(sc, _mm256_and_si256(valid, c));
       jumps = _mm256_add_epi16(jumps, j);
     }
     store(s.n + x, n);
-    store(s.sd + x, sd);
-    store(s.sdd + x, sdd);
     store(s.sc + x, sc);
-    store(s.scd + x, scd);
     store(s.jumps + x, jumps);
     if constexpr (kOutput) {
       const __m256i c0 = load(a.row + x);
-      // fit8's test on all 16 columns at once; its mean without widening the other sums.
+      // fit8's test on all 16 columns at once. n = 2h + 1 only for a window of 2h + 1 valid
+      // rows, whose offsets then sum to 0 (fit8's symmetric case).
       const __m256i candidate =
           _mm256_and_si256(_mm256_cmpeq_epi16(jumps, zero), _mm256_cmpgt_epi16(n, two));
-      const __m256i complete =
-          _mm256_and_si256(_mm256_cmpeq_epi16(sd, zero), _mm256_cmpeq_epi16(n, full));
-      if (_mm256_testc_si256(complete, candidate) != 0) {
+      if (_mm256_testc_si256(_mm256_cmpeq_epi16(n, full), candidate) != 0) {
+        // The clamp to the code +- 1 is done on the sum, in 16 bits: mean = clamp(sc, n (c - 1),
+        // n (c + 1)) / n, and c = n c / n where there is no fit. One float division of exact
+        // integers, so the value is the plain step's clamp(sc / n, c - 1, c + 1) bit for bit
+        // (division rounds monotonically and n (c +- 1) / n is exact); all within 16 bits
+        // (SubcodeRefiner's bounds).
+        const __m256i nc = _mm256_mullo_epi16(c0, full);
+        const __m256i clamped = _mm256_max_epi16(_mm256_min_epi16(sc, _mm256_add_epi16(nc, full)),
+                                                 _mm256_sub_epi16(nc, full));
+        const __m256i sum = _mm256_blendv_epi8(nc, clamped, candidate);
+        const __m256i invalid = _mm256_cmpgt_epi16(zero, c0);
+        const __m256 low = _mm256_div_ps(_mm256_cvtepi32_ps(widen_low(sum)), full_f);
+        const __m256 high = _mm256_div_ps(_mm256_cvtepi32_ps(widen_high(sum)), full_f);
         _mm256_storeu_ps(a.out + x,
-                         refined8(mean8(widen_low(sc), k), widen_low(candidate), widen_low(c0), k));
-        _mm256_storeu_ps(a.out + x + 8, refined8(mean8(widen_high(sc), k), widen_high(candidate),
-                                                 widen_high(c0), k));
+                         _mm256_blendv_ps(low, k.nan, _mm256_castsi256_ps(widen_low(invalid))));
+        _mm256_storeu_ps(a.out + x + 8,
+                         _mm256_blendv_ps(high, k.nan, _mm256_castsi256_ps(widen_high(invalid))));
         continue;
       }
-      const Window8 low{widen_low(n),  widen_low(sd),  widen_low(sdd),
-                        widen_low(sc), widen_low(scd), widen_low(jumps)};
-      const Window8 high{widen_high(n),  widen_high(sd),  widen_high(sdd),
-                         widen_high(sc), widen_high(scd), widen_high(jumps)};
-      _mm256_storeu_ps(a.out + x, fit8(low, widen_low(c0), k));
-      _mm256_storeu_ps(a.out + x + 8, fit8(high, widen_high(c0), k));
+      OffsetSums8 low{k.zero, k.zero, k.zero}, high{k.zero, k.zero, k.zero};
+      const std::int16_t* window_row = a.window_first + x;
+      for (int r = 0; r < a.window_rows; ++r, window_row += a.width) {
+        const int d = a.window_first_d + r;
+        const __m256i d32 = _mm256_set1_epi32(d);
+        const __m256i dd32 = _mm256_set1_epi32(d * d);
+        add_row8(low, load16(window_row), d32, dd32, k);
+        add_row8(high, load16(window_row + 8), d32, dd32, k);
+      }
+      _mm256_storeu_ps(a.out + x, fit8(Window8{widen_low(n), low.sd, low.sdd, widen_low(sc),
+                                               low.scd, widen_low(jumps)},
+                                       widen_low(c0), k));
+      _mm256_storeu_ps(a.out + x + 8, fit8(Window8{widen_high(n), high.sd, high.sdd, widen_high(sc),
+                                                   high.scd, widen_high(jumps)},
+                                           widen_high(c0), k));
     }
   }
-  // The remaining columns with the 32-bit sums (their own columns of SubcodeRefiner's arrays).
+  // The remaining columns with the 32-bit sums (their own columns of SubcodeRefiner's arrays),
+  // in SSE code like the caller: clean upper halves first (see triangulate_subcode_avx2).
+  _mm256_zeroupper();
   window_step_plain<kAdd, kRemove, kOutput>(a, x);
 }
 #endif
@@ -506,6 +537,8 @@ namespace {
 
 // Depth through the sub-code plane of each fractional code, one pixel at a time (the
 // reference the AVX2 loop below must equal bit for bit: the same operations in the same order).
+// kRowRay: ray_y is one value for every pixel (one row of a camera with separable rays).
+template <bool kRowRay>
 void triangulate_subcode_plain(const float* __restrict refined, const SubcodePlanes& planes,
                                const float* __restrict ray_x, const float* __restrict ray_y,
                                float min_depth_m, float max_depth_m, float* __restrict depth,
@@ -518,7 +551,7 @@ void triangulate_subcode_plain(const float* __restrict refined, const SubcodePla
     const float position = (refined[i] + 0.5f) * steps + 0.5f;
     const bool ok = (position >= 0.0f) & (position < count);  // false for NaN
     const float* pl = table + 4 * (ok ? static_cast<int>(position) : 0);
-    const float z = 1.0f / (pl[0] * ray_x[i] + pl[1] * ray_y[i] + pl[2]);
+    const float z = 1.0f / (pl[0] * ray_x[i] + pl[1] * ray_y[kRowRay ? 0 : i] + pl[2]);
     depth[i] = (ok & (z > min_depth_m) & (z < max_depth_m)) ? z : nan;
   }
 }
@@ -569,6 +602,7 @@ AVS_AVX2_INLINE __m256 depth8(__m256 u, __m256 rx, __m256 ry, const Triangulatio
   return _mm256_blendv_ps(t.nan, z, keep);
 }
 
+template <bool kRowRay>
 __attribute__((target("avx2"))) void triangulate_subcode_avx2(const float* __restrict refined,
                                                               const SubcodePlanes& planes,
                                                               const float* __restrict ray_x,
@@ -576,13 +610,18 @@ __attribute__((target("avx2"))) void triangulate_subcode_avx2(const float* __res
                                                               float min_depth_m, float max_depth_m,
                                                               float* __restrict depth, int pixels) {
   const TriangulationConstants8 t(planes, min_depth_m, max_depth_m);
+  const __m256 row_ray_y = _mm256_set1_ps(ray_y[0]);
   int i = 0;
   for (; i + 8 <= pixels; i += 8) {
     _mm256_storeu_ps(depth + i, depth8(_mm256_loadu_ps(refined + i), _mm256_loadu_ps(ray_x + i),
-                                       _mm256_loadu_ps(ray_y + i), t));
+                                       kRowRay ? row_ray_y : _mm256_loadu_ps(ray_y + i), t));
   }
-  triangulate_subcode_plain(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth, i,
-                            pixels);
+  // The plain tail and the caller are SSE code: clean upper halves first. GCC 12 left out the
+  // vzeroupper here (and in most AVX2 functions of the decoder), and SSE instructions after
+  // 256-bit ones with dirty upper halves slowed the per-row calls by 0.07 ms per depth map.
+  _mm256_zeroupper();
+  triangulate_subcode_plain<kRowRay>(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth,
+                                     i, pixels);
 }
 
 #endif
@@ -596,21 +635,53 @@ void triangulate_subcode(const float* refined, const SubcodePlanes& planes, cons
   triangulate_subcode(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth, pixels, isa);
 }
 
-void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
-                         const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
-                         int pixels, KernelIsa isa) {
+namespace {
+
+template <bool kRowRay>
+void triangulate_subcode_with(const float* refined, const SubcodePlanes& planes, const float* ray_x,
+                              const float* ray_y, float min_depth_m, float max_depth_m,
+                              float* depth, int pixels, KernelIsa isa) {
 #if defined(__x86_64__) && defined(__GNUC__)
   if (isa == KernelIsa::kAvx2) {
-    triangulate_subcode_avx2(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth,
-                             pixels);
+    triangulate_subcode_avx2<kRowRay>(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m,
+                                      depth, pixels);
     return;
   }
 #endif
-  triangulate_subcode_plain(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth, 0,
-                            pixels);
+  (void)isa;
+  triangulate_subcode_plain<kRowRay>(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth,
+                                     0, pixels);
 }
 
-void SubcodeRefiner::refine(const std::int16_t* codes, float* refined, RowSink* sink) {
+}  // namespace
+
+void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
+                         const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
+                         int pixels, KernelIsa isa) {
+  triangulate_subcode_with<false>(refined, planes, ray_x, ray_y, min_depth_m, max_depth_m, depth,
+                                  pixels, isa);
+}
+
+void triangulate_subcode_row(const float* refined_row, const SubcodePlanes& planes,
+                             const float* column_ray_x, float row_ray_y, float min_depth_m,
+                             float max_depth_m, float* depth_row, int width, KernelIsa isa) {
+  triangulate_subcode_with<true>(refined_row, planes, column_ray_x, &row_ray_y, min_depth_m,
+                                 max_depth_m, depth_row, width, isa);
+}
+
+void triangulate_subcode_row(const float* refined_row, const SubcodePlanes& planes,
+                             const float* column_ray_x, float row_ray_y, float min_depth_m,
+                             float max_depth_m, float* depth_row, int width) {
+  static const KernelIsa isa = best_kernel_isa();
+  triangulate_subcode_row(refined_row, planes, column_ray_x, row_ray_y, min_depth_m, max_depth_m,
+                          depth_row, width, isa);
+}
+
+void SubcodeRefiner::refine(const std::int16_t* codes, float* refined, RowSink* sink,
+                            RefinedRows rows) {
+  if (rows == RefinedRows::kOneRowForAll && sink == nullptr) {
+    throw std::invalid_argument("sub-code refinement: one refined row for all needs a row sink");
+  }
   const int w = params_.width;
   const int h = params_.height;
   const int half = params_.half_window;
@@ -625,16 +696,18 @@ void SubcodeRefiner::refine(const std::int16_t* codes, float* refined, RowSink* 
   const Sums<std::int32_t> sums{n_.data(),  sd_.data(),  sdd_.data(),
                                 sc_.data(), scd_.data(), jumps_.data()};
   if (narrow_) {
-    for (auto* v : {&n16_, &sd16_, &sdd16_, &sc16_, &scd16_, &jumps16_}) {
-      std::fill(v->begin(), v->end(), std::int16_t{0});
-    }
+    for (auto* v : {&n16_, &sc16_, &jumps16_}) std::fill(v->begin(), v->end(), std::int16_t{0});
     std::fill(previous_y16_.begin(), previous_y16_.end(), std::numeric_limits<std::int16_t>::min());
   }
-  const Sums<std::int16_t> sums16{n16_.data(),  sd16_.data(),  sdd16_.data(),
-                                  sc16_.data(), scd16_.data(), jumps16_.data()};
-  const Sums<std::int16_t>* narrow = narrow_ ? &sums16 : nullptr;
+  const NarrowSums sums16{n16_.data(), sc16_.data(), jumps16_.data()};
+  const NarrowSums* narrow = narrow_ ? &sums16 : nullptr;
   const auto row_of = [&](int y) { return codes + static_cast<std::ptrdiff_t>(y) * w; };
-  const auto jump_of = [&](int y) { return jump_.data() + static_cast<std::ptrdiff_t>(y) * w; };
+  // A row's flags are read when it leaves the window, 2h + 1 rows after it entered: a ring of
+  // 2h + 2 rows (in the cache) holds them.
+  const int ring = 2 * half + 2;
+  const auto jump_of = [&](int y) {
+    return jump_.data() + static_cast<std::ptrdiff_t>(y % ring) * w;
+  };
   const int max_jump = params_.max_jump;
   // The window's first h rows enter without an output row, about the origin y0 = -1 that the
   // first output step moves to 0.
@@ -652,10 +725,29 @@ void SubcodeRefiner::refine(const std::int16_t* codes, float* refined, RowSink* 
     const int y_out = leaves ? y0 - half - 1 : y0;
     auto* step = enters ? (leaves ? &window_step<true, true> : &window_step<true, false>)
                         : (leaves ? &window_step<false, true> : &window_step<false, false>);
-    float* out = refined + static_cast<std::ptrdiff_t>(y0) * w;
-    step(StepArgs{row_of(y_in), jump_of(y_in), row_of(y_out), jump_of(y_out), row_of(y0), out,
-                  previous_.data(), previous_y_.data(), sums, w, y_in, half, -half - 1, 2 * half,
-                  max_jump, narrow, previous_y16_.data()},
+    float* out =
+        rows == RefinedRows::kAll ? refined + static_cast<std::ptrdiff_t>(y0) * w : refined;
+    const int first = std::max(0, y0 - half);
+    step(StepArgs{row_of(y_in),
+                  jump_of(y_in),
+                  row_of(y_out),
+                  jump_of(y_out),
+                  row_of(y0),
+                  out,
+                  previous_.data(),
+                  previous_y_.data(),
+                  sums,
+                  w,
+                  y_in,
+                  half,
+                  -half - 1,
+                  2 * half,
+                  max_jump,
+                  narrow,
+                  previous_y16_.data(),
+                  row_of(first),
+                  std::min(h - 1, y0 + half) - first + 1,
+                  first - y0},
          isa_);
     if (sink != nullptr) sink->row_done(y0, out);
   }

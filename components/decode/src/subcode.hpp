@@ -19,8 +19,7 @@ struct SubcodeParams {
   /// mark a surface discontinuity; a window containing one keeps the plain code.
   int max_jump = 2;
   /// Codes are below this (0: unknown). When small enough for the window's sums to fit in 16 bits
-  /// ((h + 1)^2 (code_count - 1) < 2^15, the common case), the AVX2 step works on 16 columns at
-  /// once.
+  /// ((2h + 1) code_count < 2^15, the common case), the AVX2 step works on 16 columns at once.
   int code_count = 0;
 };
 
@@ -49,8 +48,14 @@ class SubcodeRefiner {
     ~RowSink() = default;
   };
 
-  /// codes: width * height, -1 where invalid. refined: width * height, NaN where invalid.
-  void refine(const std::int16_t* codes, float* refined, RowSink* sink = nullptr);
+  /// Whether `refined` holds every row or one row (width floats) that each row overwrites once
+  /// the sink has taken it (the rows stay in the cache; 4 bytes per pixel less to write back).
+  enum class RefinedRows { kAll, kOneRowForAll };
+
+  /// codes: width * height, -1 where invalid. refined: width * height (or width with
+  /// kOneRowForAll, which needs a sink), NaN where invalid.
+  void refine(const std::int16_t* codes, float* refined, RowSink* sink = nullptr,
+              RefinedRows rows = RefinedRows::kAll);
 
   const SubcodeParams& params() const { return params_; }
   /// Whether the window's sums fit in 16 bits (SubcodeParams::code_count).
@@ -62,16 +67,19 @@ class SubcodeRefiner {
   // Per column running sums over the window's valid codes about the output row (d = y - y0;
   // exact integers): count, d, d^2, code, code * d, discontinuities.
   std::vector<std::int32_t> n_, sd_, sdd_, sc_, scd_, jumps_;
-  // The same in 16 bits, and the previous valid row, for the AVX2 step on 16 columns.
+  // Count, code and discontinuities in 16 bits, and the previous valid row, for the AVX2 step
+  // on 16 columns (which takes the offset sums from the rows where it needs them).
   bool narrow_ = false;
-  std::vector<std::int16_t> n16_, sd16_, sdd16_, sc16_, scd16_, jumps16_, previous_y16_;
-  std::vector<std::uint8_t> jump_;        ///< per pixel: a discontinuity to the previous valid code
+  std::vector<std::int16_t> n16_, sc16_, jumps16_, previous_y16_;
+  /// Per pixel of the last 2h + 2 rows (a ring): a discontinuity to the previous valid code.
+  std::vector<std::uint8_t> jump_;
   std::vector<std::int16_t> previous_;    ///< per column: last valid code seen
   std::vector<std::int32_t> previous_y_;  ///< per column: its row
 };
 
 /// Binary code per pixel from the rolling window's Gray words, -1 unless every bit is known
-/// and the code is < code_count.
+/// and the code is < code_count. The decoder has them from its update pass
+/// (PairUpdateArgs::codes); this is that pass's reference (tests) and the bench's pass apart.
 void codes_from_gray(const std::uint16_t* gray, const std::uint16_t* valid, std::uint16_t full,
                      int code_count, std::int16_t* codes, int pixels);
 
@@ -86,5 +94,15 @@ void triangulate_subcode(const float* refined, const SubcodePlanes& planes, cons
 void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
                          const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
                          int pixels, KernelIsa isa);
+
+/// One image row of a camera whose rays are separable (DepthTable::column_ray_x, and its
+/// row_ray_y for this row: the same values as the per-pixel tables): 8 bytes per pixel less to
+/// read, the same depths bit for bit as triangulate_subcode on that row.
+void triangulate_subcode_row(const float* refined_row, const SubcodePlanes& planes,
+                             const float* column_ray_x, float row_ray_y, float min_depth_m,
+                             float max_depth_m, float* depth_row, int width);
+void triangulate_subcode_row(const float* refined_row, const SubcodePlanes& planes,
+                             const float* column_ray_x, float row_ray_y, float min_depth_m,
+                             float max_depth_m, float* depth_row, int width, KernelIsa isa);
 
 }  // namespace avs::decode::detail

@@ -170,7 +170,7 @@ class RollingDecoder {
   DecoderStats stats_;
   std::unique_ptr<detail::SubcodeRefiner> refiner_;  ///< set when subcode_half_window > 0
   std::vector<std::int16_t> codes_;                  ///< refinement scratch
-  std::vector<float> refined_codes_;
+  std::vector<float> refined_row_;  ///< one row of fractional codes, reused by every row
 };
 
 /// Full-cycle decode (section 4.1): all 2n frames of one cycle, matched by bit index and
