@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "avs/decode/triangulation.hpp"
 #include "subcode.hpp"
@@ -268,40 +269,96 @@ TEST(SubcodeTriangulation, InstructionSetsGiveBitIdenticalDepths) {
     refined[static_cast<std::size_t>(i)] =
         i % 17 == 0 ? std::numeric_limits<float>::quiet_NaN() : code(random);
   }
-  const SubcodePlanes planes{table.subcode_planes(), table.subcode_steps(),
-                             table.subcode_plane_count()};
-  // Odd pixel counts leave a tail for the plain loop after the 8-pixel blocks.
-  for (const int n : {pixels, pixels - 5}) {
-    for (const auto& [min_m, max_m] : {std::pair{0.3f, 1.5f}, std::pair{0.9f, 1.1f}}) {
-      std::vector<float> plain(static_cast<std::size_t>(n)), avx2(static_cast<std::size_t>(n));
-      triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), min_m, max_m,
-                          plain.data(), n, KernelIsa::kScalar);
-      triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), min_m, max_m,
-                          avx2.data(), n, KernelIsa::kAvx2);
-      int finite = 0;
-      for (const float z : plain) finite += std::isfinite(z) ? 1 : 0;
-      EXPECT_GT(finite, 100) << "some codes fall in the table and the window";
-      EXPECT_EQ(std::memcmp(plain.data(), avx2.data(), plain.size() * sizeof(float)), 0)
-          << n << " pixels, window " << min_m << ".." << max_m << " m";
+  ASSERT_NE(table.linear_subcode_planes(), nullptr) << "no projector distortion";
+  // The table of planes and the planes in closed form (the decoder's choice without projector
+  // distortion).
+  for (const bool linear : {false, true}) {
+    const SubcodePlanes planes{table.subcode_planes(), table.subcode_steps(),
+                               table.subcode_plane_count(),
+                               linear ? table.linear_subcode_planes() : nullptr};
+    // Odd pixel counts leave a tail for the plain loop after the 8-pixel blocks.
+    for (const int n : {pixels, pixels - 5}) {
+      for (const auto& [min_m, max_m] : {std::pair{0.3f, 1.5f}, std::pair{0.9f, 1.1f}}) {
+        std::vector<float> plain(static_cast<std::size_t>(n)), avx2(static_cast<std::size_t>(n));
+        triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), min_m, max_m,
+                            plain.data(), n, KernelIsa::kScalar);
+        triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), min_m, max_m,
+                            avx2.data(), n, KernelIsa::kAvx2);
+        int finite = 0;
+        for (const float z : plain) finite += std::isfinite(z) ? 1 : 0;
+        EXPECT_GT(finite, 100) << "some codes fall in the table and the window";
+        EXPECT_EQ(std::memcmp(plain.data(), avx2.data(), plain.size() * sizeof(float)), 0)
+            << n << " pixels, window " << min_m << ".." << max_m << " m";
+      }
+    }
+    // Row by row with separable rays (the decoder's way for a camera without distortion): the
+    // same depths as with the per-pixel rays.
+    ASSERT_NE(table.column_ray_x(), nullptr);
+    std::vector<float> per_pixel(static_cast<std::size_t>(pixels));
+    triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), 0.3f, 1.5f,
+                        per_pixel.data(), pixels, KernelIsa::kScalar);
+    for (const KernelIsa isa : {KernelIsa::kScalar, best_kernel_isa()}) {
+      std::vector<float> by_row(static_cast<std::size_t>(pixels));
+      for (int y = 0; y < g.camera.height; ++y) {
+        const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(y) * g.camera.width;
+        triangulate_subcode_row(refined.data() + offset, planes, table.column_ray_x(),
+                                table.row_ray_y()[y], 0.3f, 1.5f, by_row.data() + offset,
+                                g.camera.width, isa);
+      }
+      EXPECT_EQ(std::memcmp(per_pixel.data(), by_row.data(), by_row.size() * sizeof(float)), 0)
+          << kernel_isa_name(isa) << (linear ? ", planes in closed form" : ", table");
     }
   }
-  // Row by row with separable rays (the decoder's way for a camera without distortion): the
-  // same depths as with the per-pixel rays.
-  ASSERT_NE(table.column_ray_x(), nullptr);
-  std::vector<float> per_pixel(static_cast<std::size_t>(pixels));
-  triangulate_subcode(refined.data(), planes, table.ray_x(), table.ray_y(), 0.3f, 1.5f,
-                      per_pixel.data(), pixels, KernelIsa::kScalar);
-  for (const KernelIsa isa : {KernelIsa::kScalar, best_kernel_isa()}) {
-    std::vector<float> by_row(static_cast<std::size_t>(pixels));
-    for (int y = 0; y < g.camera.height; ++y) {
-      const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(y) * g.camera.width;
-      triangulate_subcode_row(refined.data() + offset, planes, table.column_ray_x(),
-                              table.row_ray_y()[y], 0.3f, 1.5f, by_row.data() + offset,
-                              g.camera.width, isa);
+}
+
+// The planes in closed form are Eq. 4's: at every code centre (u = code) their depth equals the
+// 3x3 solve of ReferenceTriangulator (double) to float precision, for the paper's sensor and
+// for a projector turned and moved off the paper's baseline; and the table's nearest sub-code
+// plane differs from them by no more than its 1/16-code step explains.
+TEST(SubcodeTriangulation, PlanesInClosedFormAreEq4s) {
+  SensorGeometry turned = default_sensor_geometry();
+  turned.R_projector_camera =
+      (Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY()) * turned.R_projector_camera).eval();
+  turned.t_projector_camera_m += Eigen::Vector3d(0.03, -0.01, 0.02);
+  for (const SensorGeometry& g : {default_sensor_geometry(), turned}) {
+    const DepthTable table(g, 16);
+    const ReferenceTriangulator reference(g);
+    ASSERT_NE(table.linear_subcode_planes(), nullptr);
+    const SubcodePlanes linear{table.subcode_planes(), table.subcode_steps(),
+                               table.subcode_plane_count(), table.linear_subcode_planes()};
+    const SubcodePlanes tabled{table.subcode_planes(), table.subcode_steps(),
+                               table.subcode_plane_count()};
+    int compared = 0;
+    double worst_relative = 0;
+    for (int i = 0; i < g.camera.width * g.camera.height; i += 211) {
+      for (int code = 0; code < g.layout.code_count; code += 3) {
+        const double z_reference = reference.point(i, code).z();
+        if (!(z_reference > 0.3 && z_reference < 3.0)) continue;
+        const float u = static_cast<float>(code);
+        float z = 0;
+        triangulate_subcode(&u, linear, table.ray_x() + i, table.ray_y() + i, 0.1f, 10.0f, &z, 1);
+        worst_relative = std::max(worst_relative, std::abs(z - z_reference) / z_reference);
+        ++compared;
+        // Off the code centre by a third of the table's step: the table keeps the centre's plane.
+        const float off = u + 1.0f / 48;
+        float z_linear = 0, z_table = 0;
+        triangulate_subcode(&off, linear, table.ray_x() + i, table.ray_y() + i, 0.1f, 10.0f,
+                            &z_linear, 1);
+        triangulate_subcode(&off, tabled, table.ray_x() + i, table.ray_y() + i, 0.1f, 10.0f,
+                            &z_table, 1);
+        EXPECT_NE(z_linear, z_table);
+        EXPECT_NEAR(z_table, z, 1e-5 * z) << "the table's plane is the centre's";
+      }
     }
-    EXPECT_EQ(std::memcmp(per_pixel.data(), by_row.data(), by_row.size() * sizeof(float)), 0)
-        << kernel_isa_name(isa);
+    EXPECT_GT(compared, 1000);
+    EXPECT_LT(worst_relative, 5e-6) << "float precision of the closed form (5 um at 1 m)";
+    std::printf("closed form vs Eq. 4 solve: %d depths, worst relative difference %.2e\n", compared,
+                worst_relative);
   }
+  SensorGeometry distorted = default_sensor_geometry();
+  distorted.projector.k1 = -0.05;
+  EXPECT_EQ(DepthTable(distorted, 16).linear_subcode_planes(), nullptr)
+      << "with projector distortion the rows are not planes: the fitted table";
 }
 
 }  // namespace

@@ -165,7 +165,7 @@ SubcodePasses time_subcode_passes(const DecoderConfig& config, const SyntheticSc
   std::vector<std::int16_t> codes(decoded.code.size());
   std::vector<float> refined(decoded.code.size()), depth(decoded.code.size());
   const detail::SubcodePlanes planes{table.subcode_planes(), table.subcode_steps(),
-                                     table.subcode_plane_count()};
+                                     table.subcode_plane_count(), table.linear_subcode_planes()};
   std::vector<double> gray_ms, window_ms, lookup_ms;
   for (int u = 0; u < updates; ++u) {
     gray_ms.push_back(time_ms([&] {

@@ -544,6 +544,20 @@ void triangulate_subcode_plain(const float* __restrict refined, const SubcodePla
                                float min_depth_m, float max_depth_m, float* __restrict depth,
                                int begin, int pixels) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  if (planes.linear != nullptr) {  // LinearSubcodePlanes: its order of operations
+    const LinearSubcodePlanes& l = *planes.linear;
+    for (int i = begin; i < pixels; ++i) {
+      const float u = refined[i];
+      const float rx = ray_x[i];
+      const float ry = ray_y[kRowRay ? 0 : i];
+      const float d0 = l.a0 * rx + (l.b0 * ry + l.c0);
+      const float d1 = l.a1 * rx + (l.b1 * ry + l.c1);
+      const float z = (l.n0 + u * l.n1) / (d0 + u * d1);
+      const bool ok = (u >= l.u_min) & (u <= l.u_max);  // false for NaN
+      depth[i] = (ok & (z > min_depth_m) & (z < max_depth_m)) ? z : nan;
+    }
+    return;
+  }
   const auto steps = static_cast<float>(planes.steps);
   const auto count = static_cast<float>(planes.count);
   const float* __restrict table = planes.planes;
@@ -602,6 +616,42 @@ AVS_AVX2_INLINE __m256 depth8(__m256 u, __m256 rx, __m256 ry, const Triangulatio
   return _mm256_blendv_ps(t.nan, z, keep);
 }
 
+// LinearSubcodePlanes on 8 pixels, the plain loop's operations one for one (no fused
+// multiply-add, the division exact).
+struct LinearConstants8 {
+  __m256 a0, b0, c0, n0, a1, b1, c1, n1, u_min, u_max, zmin, zmax, nan;
+
+  AVS_AVX2_INLINE LinearConstants8(const LinearSubcodePlanes& l, float min_depth_m,
+                                   float max_depth_m)
+      : a0(_mm256_set1_ps(l.a0)),
+        b0(_mm256_set1_ps(l.b0)),
+        c0(_mm256_set1_ps(l.c0)),
+        n0(_mm256_set1_ps(l.n0)),
+        a1(_mm256_set1_ps(l.a1)),
+        b1(_mm256_set1_ps(l.b1)),
+        c1(_mm256_set1_ps(l.c1)),
+        n1(_mm256_set1_ps(l.n1)),
+        u_min(_mm256_set1_ps(l.u_min)),
+        u_max(_mm256_set1_ps(l.u_max)),
+        zmin(_mm256_set1_ps(min_depth_m)),
+        zmax(_mm256_set1_ps(max_depth_m)),
+        nan(_mm256_set1_ps(std::numeric_limits<float>::quiet_NaN())) {}
+};
+
+AVS_AVX2_INLINE __m256 linear_depth8(__m256 u, __m256 rx, __m256 ry, const LinearConstants8& l) {
+  const __m256 d0 =
+      _mm256_add_ps(_mm256_mul_ps(l.a0, rx), _mm256_add_ps(_mm256_mul_ps(l.b0, ry), l.c0));
+  const __m256 d1 =
+      _mm256_add_ps(_mm256_mul_ps(l.a1, rx), _mm256_add_ps(_mm256_mul_ps(l.b1, ry), l.c1));
+  const __m256 z = _mm256_div_ps(_mm256_add_ps(l.n0, _mm256_mul_ps(u, l.n1)),
+                                 _mm256_add_ps(d0, _mm256_mul_ps(u, d1)));
+  const __m256 ok =
+      _mm256_and_ps(_mm256_cmp_ps(u, l.u_min, _CMP_GE_OQ), _mm256_cmp_ps(u, l.u_max, _CMP_LE_OQ));
+  const __m256 keep = _mm256_and_ps(ok, _mm256_and_ps(_mm256_cmp_ps(z, l.zmin, _CMP_GT_OQ),
+                                                      _mm256_cmp_ps(z, l.zmax, _CMP_LT_OQ)));
+  return _mm256_blendv_ps(l.nan, z, keep);
+}
+
 template <bool kRowRay>
 __attribute__((target("avx2"))) void triangulate_subcode_avx2(const float* __restrict refined,
                                                               const SubcodePlanes& planes,
@@ -609,10 +659,18 @@ __attribute__((target("avx2"))) void triangulate_subcode_avx2(const float* __res
                                                               const float* __restrict ray_y,
                                                               float min_depth_m, float max_depth_m,
                                                               float* __restrict depth, int pixels) {
-  const TriangulationConstants8 t(planes, min_depth_m, max_depth_m);
   const __m256 row_ray_y = _mm256_set1_ps(ray_y[0]);
   int i = 0;
-  for (; i + 8 <= pixels; i += 8) {
+  if (planes.linear != nullptr) {
+    const LinearConstants8 l(*planes.linear, min_depth_m, max_depth_m);
+    for (; i + 8 <= pixels; i += 8) {
+      _mm256_storeu_ps(depth + i,
+                       linear_depth8(_mm256_loadu_ps(refined + i), _mm256_loadu_ps(ray_x + i),
+                                     kRowRay ? row_ray_y : _mm256_loadu_ps(ray_y + i), l));
+    }
+  }
+  const TriangulationConstants8 t(planes, min_depth_m, max_depth_m);
+  for (; planes.linear == nullptr && i + 8 <= pixels; i += 8) {
     _mm256_storeu_ps(depth + i, depth8(_mm256_loadu_ps(refined + i), _mm256_loadu_ps(ray_x + i),
                                        kRowRay ? row_ray_y : _mm256_loadu_ps(ray_y + i), t));
   }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "avs/decode/triangulation.hpp"
 #include "rolling_kernel.hpp"
 
 namespace avs::decode::detail {
@@ -27,6 +28,9 @@ struct SubcodePlanes {
   const float* planes = nullptr;  ///< DepthTable::subcode_planes()
   int steps = 0;                  ///< per code
   int count = 0;                  ///< planes
+  /// DepthTable::linear_subcode_planes(): when set, the planes in closed form (used instead of
+  /// the table).
+  const LinearSubcodePlanes* linear = nullptr;
 };
 
 /// Per column, a least-squares line code(y) through the valid codes of the window
@@ -83,9 +87,10 @@ class SubcodeRefiner {
 void codes_from_gray(const std::uint16_t* gray, const std::uint16_t* valid, std::uint16_t full,
                      int code_count, std::int16_t* codes, int pixels);
 
-/// Depth through the nearest sub-code plane of each fractional code (NaN codes, codes outside
-/// the table and depths outside (min, max) give NaN), with the best instruction set of this
-/// CPU (best_kernel_isa()).
+/// Depth through the plane of each fractional code (NaN codes, codes outside the coded range
+/// and depths outside (min, max) give NaN): in closed form when planes.linear is set, else
+/// through the nearest sub-code plane of the table; with the best instruction set of this CPU
+/// (best_kernel_isa()).
 void triangulate_subcode(const float* refined, const SubcodePlanes& planes, const float* ray_x,
                          const float* ray_y, float min_depth_m, float max_depth_m, float* depth,
                          int pixels);

@@ -1,5 +1,6 @@
 #include "avs/decode/triangulation.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -89,6 +90,26 @@ DepthTable::DepthTable(const SensorGeometry& g, int subcode_steps) {
       const double code = static_cast<double>(j) / subcode_steps - 0.5;
       fit_row_plane(g, subcode_row(g, code), sub_step,
                     subcode_planes_.data() + 4 * static_cast<std::size_t>(j), &ignored);
+    }
+    if (!g.projector.has_distortion()) {
+      // Eq. 4's projector row: plane(v) = P_2 - v P_3 through the projector centre, with
+      // v = alpha + beta u. A point z (x, y, 1) on it: z (plane_xyz . r) + plane_w = 0. Scaled
+      // to numbers near 1 (the depth does not depend on the plane's scale).
+      const Eigen::Matrix<double, 3, 4> P = g.projector_matrix();
+      const double alpha = subcode_row(g, 0.0);
+      const double beta = subcode_row(g, 1.0) - alpha;
+      const Eigen::Vector4d plane0 = P.row(1).transpose() - alpha * P.row(2).transpose();
+      const Eigen::Vector4d plane1 = -beta * P.row(2).transpose();
+      const double scale = std::max(plane0.cwiseAbs().maxCoeff(), plane1.cwiseAbs().maxCoeff());
+      if (scale > 0) {
+        const auto f = [scale](double v) { return static_cast<float>(v / scale); };
+        linear_subcode_planes_ = {f(plane0.x()), f(plane0.y()),
+                                  f(plane0.z()), f(-plane0.w()),
+                                  f(plane1.x()), f(plane1.y()),
+                                  f(plane1.z()), f(-plane1.w()),
+                                  -0.5f,         static_cast<float>(g.layout.code_count) - 0.5f};
+        has_linear_subcode_planes_ = true;
+      }
     }
   }
 }

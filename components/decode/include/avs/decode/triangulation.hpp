@@ -11,6 +11,19 @@
 
 namespace avs::decode {
 
+/// The plane of a fractional code u for a projector without distortion, exactly: the plane of
+/// projector row v is P_2 - v P_3 (Eq. 4's third row, P = K_p [R | t]) and v is linear in u, so
+/// the plane is too. A camera ray (x, y, 1) meets it at depth
+///   z = (n0 + u n1) / ((a0 x + (b0 y + c0)) + u (a1 x + (b1 y + c1)))
+/// (this order of operations, in float, is the definition every implementation follows), for
+/// u in [u_min, u_max] (the coded rows), NaN elsewhere. No 1 / subcode_steps quantisation of u
+/// and no table to look up.
+struct LinearSubcodePlanes {
+  float a0 = 0, b0 = 0, c0 = 0, n0 = 0;
+  float a1 = 0, b1 = 0, c1 = 0, n1 = 0;
+  float u_min = 0, u_max = 0;
+};
+
 /// The paper's look-up table in a form that fits in cache (~2 MiB for 512 x 512): per camera
 /// pixel the undistorted ray (x, y, 1); per code the plane through the projector centre and the
 /// code's centre row (projector distortion included: the plane is fitted to the undistorted
@@ -54,18 +67,12 @@ class DepthTable {
     return subcode_planes_.empty() ? nullptr : subcode_planes_.data();
   }
   int subcode_steps() const { return subcode_steps_; }
-  int subcode_plane_count() const { return static_cast<int>(subcode_planes_.size() / 4); }
-  /// Depth of `pixel_index` for fractional code u (nearest sub-code plane); NaN outside the
-  /// coded range or without sub-code planes.
-  float subcode_depth(int pixel_index, float u) const {
-    const float position = (u + 0.5f) * static_cast<float>(subcode_steps_) + 0.5f;
-    if (!(position >= 0.0f) || position >= static_cast<float>(subcode_plane_count())) {
-      return std::numeric_limits<float>::quiet_NaN();
-    }
-    const float* pl = subcode_planes_.data() + 4 * static_cast<int>(position);
-    return 1.0f / (pl[0] * ray_x_[pixel_index] + pl[1] * ray_y_[pixel_index] + pl[2]);
+  /// With sub-code planes and a projector without distortion: the same planes in closed form
+  /// (what the decoder uses then); null otherwise.
+  const LinearSubcodePlanes* linear_subcode_planes() const {
+    return has_linear_subcode_planes_ ? &linear_subcode_planes_ : nullptr;
   }
-
+  int subcode_plane_count() const { return static_cast<int>(subcode_planes_.size() / 4); }
   /// Largest distance (m) between a fitted plane and the rays of its row, over all codes: 0
   /// without projector distortion; reported so that callers can see the plane approximation.
   double max_plane_fit_error() const { return max_plane_fit_error_; }
@@ -82,6 +89,8 @@ class DepthTable {
   double max_plane_fit_error_ = 0;
   int subcode_steps_ = 0;
   std::vector<float> subcode_planes_;
+  bool has_linear_subcode_planes_ = false;
+  LinearSubcodePlanes linear_subcode_planes_;
 
   static double subcode_row(const SensorGeometry& g, double code);
   /// Plane through the projector centre and projector row `row` (fitted to every column_step-th
