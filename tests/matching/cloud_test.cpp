@@ -1,6 +1,7 @@
 #include <cmath>
 #include <random>
 #include <stdexcept>
+#include <vector>
 
 #include <limits>
 
@@ -109,6 +110,68 @@ TEST(SceneCloud, MaskSelectsPixels) {
   ASSERT_FALSE(scene.empty());
   for (const auto& p : scene) EXPECT_LT(p.x(), 0.001F);
   EXPECT_LT(builder.valid_pixels(), depth.valid_pixels() / 2 + 600);
+}
+
+// The valid pixels M of Eq. 27 and the sampled points, written pixel by pixel from the
+// definition (finite, within the depth window, in the mask), on a depth image with NaN, both
+// infinities, depths outside the window and a patchy mask: the builder's per-row counting and
+// its skipping of rows without a sample give the same count and the same points.
+TEST(SceneCloud, CountsAndSamplesAsTheDefinitionSays) {
+  const geometry::CameraModel camera = test::test_camera();
+  constexpr int kSide = 512;
+  std::mt19937 random(17);
+  std::uniform_real_distribution<float> unit(0.0F, 1.0F);
+  std::vector<float> depth(kSide * kSide);
+  std::vector<std::uint8_t> mask(depth.size());
+  const float inf = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < depth.size(); ++i) {
+    const float r = unit(random);
+    const int row = static_cast<int>(i) / kSide;
+    depth[i] = r < 0.05F   ? std::numeric_limits<float>::quiet_NaN()
+               : r < 0.08F ? inf
+               : r < 0.10F ? -inf
+               : r < 0.15F ? 0.01F  // below the window
+               : r < 0.20F ? 12.0F  // beyond it
+                           : (row % 7 == 0 ? 0.4F : 0.5F) + 0.5F * unit(random);
+    mask[i] = (row / 40) % 3 == 2 ? 0 : (unit(random) < 0.9F ? 1 : 0);
+  }
+  for (const bool with_mask : {false, true}) {
+    SceneCloudConfig config;
+    config.voxel_size_m = 0.0F;     // the sampled points themselves
+    config.outlier_neighbours = 0;  // no outlier test
+    config.target_points = 250;
+    SceneCloudBuilder builder(config);
+    const Points& cloud = builder.build({depth.data(), kSide, kSide, 0},
+                                        {with_mask ? mask.data() : nullptr, 0}, camera);
+    std::vector<int> valid;
+    for (int i = 0; i < kSide * kSide; ++i) {
+      const float z = depth[static_cast<std::size_t>(i)];
+      if (std::isfinite(z) && z >= config.min_depth_m && z <= config.max_depth_m &&
+          (!with_mask || mask[static_cast<std::size_t>(i)] != 0)) {
+        valid.push_back(i);
+      }
+    }
+    EXPECT_EQ(builder.valid_pixels(), valid.size());
+    const double ratio = stride_ratio(valid.size(), config.target_points);
+    std::vector<Eigen::Vector3f> expected;
+    double next = ratio - 1.0;
+    for (std::size_t k = 0; k < valid.size(); ++k) {
+      if (static_cast<double>(k) < next) continue;
+      const int u = valid[k] % kSide, v = valid[k] / kSide;
+      const float z = depth[static_cast<std::size_t>(valid[k])];
+      expected.emplace_back((static_cast<float>(u) - static_cast<float>(camera.cx_px)) * z /
+                                static_cast<float>(camera.fx_px),
+                            (static_cast<float>(v) - static_cast<float>(camera.cy_px)) * z /
+                                static_cast<float>(camera.fy_px),
+                            z);
+      next += ratio;
+    }
+    ASSERT_EQ(cloud.size(), expected.size()) << (with_mask ? "with mask" : "without mask");
+    EXPECT_GE(cloud.size(), 240U);
+    for (std::size_t k = 0; k < cloud.size(); ++k) {
+      ASSERT_EQ(cloud[k], expected[k]) << "point " << k;
+    }
+  }
 }
 
 TEST(SceneCloud, RemovesIsolatedPoints) {

@@ -47,6 +47,7 @@ class SceneCloudBuilder {
  private:
   SceneCloudConfig config_;
   std::size_t valid_pixels_ = 0;
+  std::vector<std::uint32_t> row_valid_;  ///< valid pixels per image row of the last frame
   Points sampled_;
   Points voxels_;
   Points result_;
