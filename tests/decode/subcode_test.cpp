@@ -161,7 +161,8 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
   int narrow_runs = 0;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   // Codes of a few hundred, then (half > 0) codes up to the largest the 16-bit sums of that
-  // half window allow, (2h + 1)(largest + 1) < 2^15, so that those sums come near their limits.
+  // half window allow, (2h + 1)(largest + 1) and h (h + 1) largest below 2^15, so that those
+  // sums come near their limits.
   struct Field {
     int width, height, half;
   };
@@ -169,7 +170,9 @@ TEST(SubcodeRefiner, EqualsTheFitWrittenPixelByPixel) {
                             Field{37, 60, 4}, Field{46, 60, 7}, Field{37, 60, 16}}) {
     const int width = field.width;
     const int height = field.height;
-    const int largest = field.half > 0 ? 32767 / (2 * field.half + 1) - 1 : 0;
+    const int largest = field.half > 0 ? std::min(32767 / (2 * field.half + 1) - 1,
+                                                  32767 / (field.half * (field.half + 1)))
+                                       : 0;
     std::vector<std::int16_t> codes(static_cast<std::size_t>(width) * height);
     for (int x = 0; x < width; ++x) {
       double f = largest > 0 ? largest - 60.0 + x : 40.0 + 3.0 * x;

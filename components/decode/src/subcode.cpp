@@ -22,12 +22,14 @@ SubcodeRefiner::SubcodeRefiner(SubcodeParams params, KernelIsa isa) : params_(pa
   // 16-bit factors of the AVX2 steps' products (vpmaddwd, vpmullw).
   params_.max_jump = std::min(params_.max_jump, 32767);
   const auto w = static_cast<std::size_t>(params_.width);
-  // The 16-bit sums (count, code, discontinuities) are exact (wrapping arithmetic, exact at
-  // every output) when the largest values fit: sc <= (2h + 1) c and the mean's clamp bound
-  // (2h + 1)(c + 1) for c = the largest code; the rows (y, and the gap before a discontinuity
-  // times max_jump) fit as well.
+  // The 16-bit sums are exact (wrapping arithmetic, exact at every output) when the largest
+  // values fit: sc <= (2h + 1) c and the mean's clamp bound (2h + 1)(c + 1), |scd| <= h (h + 1) c
+  // for c = the largest code; the rows (y, and the gap before a discontinuity times max_jump)
+  // fit as well.
   const int h = params_.half_window;
+  const long largest_code = static_cast<long>(params_.code_count) - 1;
   narrow_ = params_.code_count > 0 && static_cast<long>(2 * h + 1) * params_.code_count < 32768 &&
+            static_cast<long>(h) * (h + 1) * largest_code < 32768 &&
             static_cast<long>(2 * h + 2) * params_.max_jump < 32768 && params_.height < 32768;
   if (narrow_) {
     for (auto* v : {&n16_, &sc16_, &jumps16_, &previous_y16_}) {
@@ -385,25 +387,13 @@ AVS_AVX2_INLINE __m256i widen_high(__m256i v) {
   return _mm256_cvtepi16_epi32(_mm256_extracti128_si256(v, 1));
 }
 
-// The offset sums sd, sdd, scd of 8 columns (c: their codes widened, 16 bits in the low half
-// of each lane) from the window's rows: exact integers, equal to the running sums.
-struct OffsetSums8 {
-  __m256i sd, sdd, scd;
-};
-AVS_AVX2_INLINE void add_row8(OffsetSums8& o, __m256i c, __m256i d, __m256i dd,
-                              const WindowConstants8& k) {
-  const __m256i valid = _mm256_cmpgt_epi32(c, k.minus_one);
-  o.sd = _mm256_add_epi32(o.sd, _mm256_and_si256(valid, d));
-  o.sdd = _mm256_add_epi32(o.sdd, _mm256_and_si256(valid, dd));
-  o.scd = _mm256_add_epi32(o.scd, _mm256_mullo_epi32(_mm256_and_si256(valid, c), d));
-}
-
 // window_step_plain on 16 columns at once with 16-bit sums of count, code and discontinuities
 // (StepArgs::narrow): the same additions modulo 2^16, exact whenever a result is used
 // (SubcodeRefiner's bounds). A block whose fitted columns all have the complete window (the
-// common case) needs no more: the fit is the window's mean. The other blocks (near invalid
-// pixels and the image's top and bottom) take their offset sums sd, sdd, scd from the window's
-// rows, in 32 bits, and the line fit of fit8: no running offset sums to move for every block.
+// common case, even with the ken's edges and shadows in view) needs no more: the fit is the
+// window's mean. The other blocks (near invalid pixels and the image's top and bottom) take their
+// offset sums sd, sdd, scd from the window's rows and the line fit of fit8: no running offset sums
+// to move for every block.
 template <bool kAdd, bool kRemove, bool kOutput>
 __attribute__((target("avx2"))) void window_step_avx2_narrow(const StepArgs& a) {
   const NarrowSums& s = *a.narrow;
@@ -478,21 +468,25 @@ __attribute__((target("avx2"))) void window_step_avx2_narrow(const StepArgs& a) 
                          _mm256_blendv_ps(high, k.nan, _mm256_castsi256_ps(widen_high(invalid))));
         continue;
       }
-      OffsetSums8 low{k.zero, k.zero, k.zero}, high{k.zero, k.zero, k.zero};
+      // The offset sums of the window's valid rows (d = y - y0), in 16 bits: |scd| <= h (h + 1)
+      // times the largest code, |sd|, sdd smaller (SubcodeRefiner's bounds), so exact.
+      __m256i sd = zero, sdd = zero, scd = zero;
       const std::int16_t* window_row = a.window_first + x;
       for (int r = 0; r < a.window_rows; ++r, window_row += a.width) {
         const int d = a.window_first_d + r;
-        const __m256i d32 = _mm256_set1_epi32(d);
-        const __m256i dd32 = _mm256_set1_epi32(d * d);
-        add_row8(low, load16(window_row), d32, dd32, k);
-        add_row8(high, load16(window_row + 8), d32, dd32, k);
+        const __m256i c = load(window_row);
+        const __m256i valid = _mm256_cmpgt_epi16(c, minus_one);
+        sd = _mm256_add_epi16(sd, _mm256_and_si256(valid, word(d)));
+        sdd = _mm256_add_epi16(sdd, _mm256_and_si256(valid, word(d * d)));
+        scd = _mm256_add_epi16(scd, _mm256_mullo_epi16(_mm256_and_si256(valid, c), word(d)));
       }
-      _mm256_storeu_ps(a.out + x, fit8(Window8{widen_low(n), low.sd, low.sdd, widen_low(sc),
-                                               low.scd, widen_low(jumps)},
+      _mm256_storeu_ps(a.out + x, fit8(Window8{widen_low(n), widen_low(sd), widen_low(sdd),
+                                               widen_low(sc), widen_low(scd), widen_low(jumps)},
                                        widen_low(c0), k));
-      _mm256_storeu_ps(a.out + x + 8, fit8(Window8{widen_high(n), high.sd, high.sdd, widen_high(sc),
-                                                   high.scd, widen_high(jumps)},
-                                           widen_high(c0), k));
+      _mm256_storeu_ps(a.out + x + 8,
+                       fit8(Window8{widen_high(n), widen_high(sd), widen_high(sdd), widen_high(sc),
+                                    widen_high(scd), widen_high(jumps)},
+                            widen_high(c0), k));
     }
   }
   // The remaining columns with the 32-bit sums (their own columns of SubcodeRefiner's arrays),

@@ -20,7 +20,8 @@ struct SubcodeParams {
   /// mark a surface discontinuity; a window containing one keeps the plain code.
   int max_jump = 2;
   /// Codes are below this (0: unknown). When small enough for the window's sums to fit in 16 bits
-  /// ((2h + 1) code_count < 2^15, the common case), the AVX2 step works on 16 columns at once.
+  /// ((2h + 1) code_count and h (h + 1)(code_count - 1) below 2^15, the common case), the AVX2
+  /// step works on 16 columns at once.
   int code_count = 0;
 };
 
