@@ -1,6 +1,8 @@
 #include "avs/tracking/moments.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -41,6 +43,74 @@ TEST(Moments, DepthWindowIsStrictAndNanIsNotTarget) {
   const TargetObservation obs = measure_target(img.view(), camera, {0.5, 1.5, 5});
   EXPECT_DOUBLE_EQ(obs.m00, 9);
   EXPECT_DOUBLE_EQ(obs.centroid_u_px, 31);
+}
+
+// Eq. 7-9 written pixel by pixel (rows in order, each row's depths summed left to right, as
+// the exact-sum contract says) on a full-size image of scattered target pixels, NaN, both
+// infinities and depths outside the window, over regions whose edges do not fall on the 16-pixel
+// blocks the implementation skips: the same moments, mean depth and bounds to the last bit.
+TEST(Moments, EqualsTheDefinitionPixelByPixel) {
+  constexpr int kSide = 512;
+  std::vector<float> depth(kSide * kSide);
+  std::uint32_t state = 12345;
+  const auto next = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / 16777216.0f;
+  };
+  const float inf = std::numeric_limits<float>::infinity();
+  for (int v = 0; v < kSide; ++v) {
+    for (int u = 0; u < kSide; ++u) {
+      const float r = next();
+      // Target pixels scattered (a few per block) and a dense patch; the rest is not target.
+      const bool patch = u >= 200 && u < 263 && v >= 100 && v < 180;
+      float z = 2.5f;
+      if (patch || r < 0.02f)
+        z = 0.6f + next();
+      else if (r < 0.05f)
+        z = nan_f;
+      else if (r < 0.06f)
+        z = inf;
+      else if (r < 0.07f)
+        z = -inf;
+      depth[static_cast<std::size_t>(v) * kSide + u] = z;
+    }
+  }
+  const geometry::DepthView view{depth.data(), kSide, kSide, 0};
+  for (const PixelBox& region : {PixelBox{}, PixelBox{3, 300, 7, 411}, PixelBox{201, 262, 99, 181},
+                                 PixelBox{17, 17, 0, 511}}) {
+    MomentsConfig config{0.5, 1.5, 10, region};
+    const TargetObservation obs = measure_target(view, camera, config);
+    double m00 = 0, m10 = 0, m01 = 0, depth_sum = 0;
+    PixelBox bounds{std::numeric_limits<int>::max(), -1, std::numeric_limits<int>::max(), -1};
+    for (int v = std::max(0, region.v_min); v <= std::min(kSide - 1, region.v_max); ++v) {
+      long count = 0, u_sum = 0;
+      double row_depth = 0;
+      for (int u = std::max(0, region.u_min); u <= std::min(kSide - 1, region.u_max); ++u) {
+        const float h = depth[static_cast<std::size_t>(v) * kSide + u];
+        if (!(0.5f < h && h < 1.5f)) continue;
+        ++count;
+        u_sum += u;
+        row_depth += h;
+        bounds.u_min = std::min(bounds.u_min, u);
+        bounds.u_max = std::max(bounds.u_max, u);
+        bounds.v_min = std::min(bounds.v_min, v);
+        bounds.v_max = v;
+      }
+      m00 += static_cast<double>(count);
+      m10 += static_cast<double>(u_sum) - camera.cx_px * static_cast<double>(count);
+      m01 += (v - camera.cy_px) * static_cast<double>(count);
+      depth_sum += row_depth;
+    }
+    ASSERT_GT(m00, 0);
+    EXPECT_EQ(obs.m00, m00);
+    EXPECT_EQ(obs.m10, m10);
+    EXPECT_EQ(obs.m01, m01);
+    EXPECT_EQ(obs.mean_depth_m, depth_sum / m00);
+    EXPECT_EQ(obs.bounds.u_min, bounds.u_min);
+    EXPECT_EQ(obs.bounds.u_max, bounds.u_max);
+    EXPECT_EQ(obs.bounds.v_min, bounds.v_min);
+    EXPECT_EQ(obs.bounds.v_max, bounds.v_max);
+  }
 }
 
 TEST(Moments, MinimumAreaDecidesPresence) {

@@ -5,7 +5,33 @@
 #include <stdexcept>
 #include <string>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace avs::tracking {
+namespace {
+
+constexpr int kBlock = 16;  ///< pixels tested at once for any target pixel
+
+/// Whether any of the kBlock depths at p lies in (lo, hi) (NaN does not).
+bool any_within(const float* p, float lo, float hi) {
+#if defined(__SSE2__)
+  const __m128 low = _mm_set1_ps(lo), high = _mm_set1_ps(hi);
+  __m128 any = _mm_setzero_ps();
+  for (int k = 0; k < kBlock; k += 4) {
+    const __m128 h = _mm_loadu_ps(p + k);
+    any = _mm_or_ps(any, _mm_and_ps(_mm_cmplt_ps(low, h), _mm_cmplt_ps(h, high)));
+  }
+  return _mm_movemask_ps(any) != 0;
+#else
+  bool any = false;
+  for (int k = 0; k < kBlock; ++k) any |= (lo < p[k]) & (p[k] < hi);
+  return any;
+#endif
+}
+
+}  // namespace
 
 TargetObservation measure_target(const geometry::DepthView& depth,
                                  const geometry::CameraModel& camera, const MomentsConfig& config) {
@@ -32,14 +58,24 @@ TargetObservation measure_target(const geometry::DepthView& depth,
     double row_depth = 0;
     int first = -1;
     int last = -1;
-    for (int u = u_begin; u <= u_end; ++u) {
-      const float h = row[u];
-      if (lo < h && h < hi) {  // Eq. 8 (NaN compares false)
-        ++count;
-        u_sum += u;
-        row_depth += h;
-        if (first < 0) first = u;
-        last = u;
+    // Blocks of 16 pixels without a target pixel (most of the image) are passed after one
+    // branch-free test that the compiler vectorises; the others are summed pixel by pixel in
+    // the same order as before, so the sums are the same to the last bit.
+    for (int u = u_begin; u <= u_end;) {
+      const int block_end = std::min(u + kBlock, u_end + 1);
+      if (block_end - u == kBlock && !any_within(row + u, lo, hi)) {
+        u = block_end;
+        continue;
+      }
+      for (; u < block_end; ++u) {
+        const float h = row[u];
+        if (lo < h && h < hi) {  // Eq. 8 (NaN compares false)
+          ++count;
+          u_sum += u;
+          row_depth += h;
+          if (first < 0) first = u;
+          last = u;
+        }
       }
     }
     if (count == 0) continue;
