@@ -853,8 +853,27 @@ int Container::run() {
     if (mode == TimeMode::sim_lockstep && graph_.clock.wait_for_recorders) {
       c.recorder_acks = std::make_unique<RecorderAcks>(c.participant, std::move(watched), c.log,
                                                        std::chrono::seconds(2));
-      scheduler.before_time_advance([&c, &scheduler] {
+      const double start_timeout_s = graph_.clock.recorder_start_timeout_s;
+      scheduler.before_time_advance([&c, &scheduler, start_timeout_s,
+                                     first = start_timeout_s > 0.0]() mutable {
         try {
+          if (first) {  // once: a recorder started first, still being discovered
+            first = false;
+            const auto started = std::chrono::steady_clock::now();
+            const bool found = c.recorder_acks->wait_for_a_recorder(
+                std::chrono::duration_cast<Duration>(
+                    std::chrono::duration<double>(start_timeout_s)),
+                [&scheduler] { return scheduler.stopped(); });
+            const double waited_s =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+            if (found) {
+              c.log.info("a recorder matched after ", waited_s, " s: starting (clock ",
+                         "recorder_start_timeout_s)");
+            } else {
+              c.log.warn("no recorder matched within ", start_timeout_s,
+                         " s (clock recorder_start_timeout_s): starting without one");
+            }
+          }
           c.recorder_acks->wait([&scheduler] { return scheduler.stopped(); });
         } catch (const std::exception& e) {
           c.log.warn("waiting for recorders: ", e.what());

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <set>
 #include <string_view>
+#include <thread>
 
 #include "avs/msg/type_support.hpp"
 #include "avs/runtime/raw_topic.hpp"
@@ -97,6 +98,21 @@ bool RecorderAcks::caught_up(const Gid& gid, std::int64_t source_ns) {
     if (newest < source_ns) return false;
   }
   return any;
+}
+
+bool RecorderAcks::wait_for_a_recorder(Duration timeout,
+                                       const std::function<bool()>& stop_requested) const {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    for (const Writer& w : writers_) {
+      if (!w.watched.reliable) continue;
+      dds_publication_matched_status_t status{};
+      if (dds_get_publication_matched_status(w.watched.writer->get(), &status) < 0) continue;
+      if (status.current_count > 0 && has_recorder(*w.watched.writer)) return true;
+    }
+    if (stop_requested() || std::chrono::steady_clock::now() >= deadline) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
 }
 
 void RecorderAcks::wait(const std::function<bool()>& stop_requested) {

@@ -41,6 +41,9 @@ class RecorderAcks {
   /// Before a lockstep step: waits where a recorder would otherwise lose samples, at most
   /// `timeout` in all, and not once `stop_requested` says so.
   void wait(const std::function<bool()>& stop_requested);
+  /// Before the first step (ClockSpec::recorder_start_timeout_s): waits until a recorder has
+  /// matched one of the reliable writers, at most `timeout`; whether one did.
+  bool wait_for_a_recorder(Duration timeout, const std::function<bool()>& stop_requested) const;
   /// Waits that ran out of time (the recorder then loses samples, and reports them).
   std::uint64_t timeouts() const { return timeouts_; }
 

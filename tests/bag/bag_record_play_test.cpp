@@ -779,11 +779,12 @@ TEST(BagRecord, ALockstepTalkerWaitsForItsStoppedRecorder) {
   const int status = rec.wait(30s);
   const std::string out = rec.output();
   EXPECT_EQ(exit_code(status), 0) << out;
-  // From the first message the recorder got (the graph may run thousands of steps, 5760 once,
-  // before the two processes have discovered each other: the recording starts there, docs/bag.md
-  // "Known limit") to the talker's last.
+  // From the talker's first messages (the graph holds its first step until the recorder has
+  // matched: clock recorder_start_timeout_s; without it the graph ran 5760 steps once, and its
+  // whole 20 s another time, before discovery) to its last.
   const auto seqs = chatter_sequence(read_all(file));
   ASSERT_FALSE(seqs.empty()) << out;
+  EXPECT_LE(seqs.front(), 10u) << "the recording starts with the graph\n" << out;
   expect_consecutive(seqs, "the recording");
   EXPECT_GE(seqs.back(), 19998u) << "20 s at 1 kHz\n" << out;
   EXPECT_GE(seqs.size(), 10000u) << out;

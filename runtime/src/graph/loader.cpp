@@ -26,8 +26,13 @@ namespace fs = std::filesystem;
 
 const std::vector<std::string> top_keys = {"args",  "namespace", "domain_id",
                                            "clock", "include",   "containers"};
-const std::vector<std::string> clock_keys = {"source", "mode",       "real_time_factor",
-                                             "master", "duration_s", "wait_for_recorders"};
+const std::vector<std::string> clock_keys = {"source",
+                                             "mode",
+                                             "real_time_factor",
+                                             "master",
+                                             "duration_s",
+                                             "wait_for_recorders",
+                                             "recorder_start_timeout_s"};
 
 /// Argument values handed to a file: from the command line (top-level file) or from the
 /// `args:` of an include entry.
@@ -39,7 +44,8 @@ struct GivenArgs {
 bool same_clock(const ClockSpec& a, const ClockSpec& b) {
   return a.source == b.source && a.mode == b.mode && a.real_time_factor == b.real_time_factor &&
          a.master == b.master && a.duration_s == b.duration_s &&
-         a.wait_for_recorders == b.wait_for_recorders;
+         a.wait_for_recorders == b.wait_for_recorders &&
+         a.recorder_start_timeout_s == b.recorder_start_timeout_s;
 }
 
 /// The default text of an argument declaration (scalar, or a list written as "[a, b]").
@@ -142,6 +148,8 @@ std::optional<ClockSpec> read_clock(LoadState& state, const FileReader& reader,
     } else if (e.key == "wait_for_recorders") {
       if (auto i = reader.choice(e.value, what, {"false", "true"}))
         clock.wait_for_recorders = *i == 1;
+    } else if (e.key == "recorder_start_timeout_s") {
+      if (auto v = reader.number(e.value, what, 0.0, 3600.0)) clock.recorder_start_timeout_s = *v;
     }
   }
   if (state.diags.count() != errors_before) return std::nullopt;

@@ -83,6 +83,11 @@ struct ClockSpec {
   /// matched readers waits until the recorder has acknowledged what it may otherwise overwrite,
   /// so the recording is complete whatever the load (issue 20 section 6, docs/bag.md).
   bool wait_for_recorders = true;
+  /// Lockstep with wait_for_recorders: before the first step, wait up to this long (s) for a
+  /// recorder to match one of the container's writers. DDS discovery can take longer than a
+  /// light graph's whole run, so a recording started first may otherwise miss the start (or
+  /// all of it); 0 (the default): start at once.
+  double recorder_start_timeout_s = 0.0;
 };
 
 struct Graph {
