@@ -56,14 +56,17 @@ std::unique_ptr<detail::SubcodeRefiner> make_refiner(const DecoderConfig& c) {
       c.geometry.layout.code_count});
 }
 
+/// The table's sub-code planes (in closed form where it has them) for detail::triangulate_subcode.
+detail::SubcodePlanes subcode_planes_of(const DepthTable& table) {
+  return {table.subcode_planes(), table.subcode_steps(), table.subcode_plane_count(),
+          table.linear_subcode_planes()};
+}
+
 /// Depth from fractional codes through the sub-code planes (NaN codes give NaN), all pixels.
 void triangulate_subcode(const DepthTable& table, const float* refined, const DecoderConfig& c,
                          float* depth_out) {
-  detail::triangulate_subcode(refined,
-                              {table.subcode_planes(), table.subcode_steps(),
-                               table.subcode_plane_count(), table.linear_subcode_planes()},
-                              table.ray_x(), table.ray_y(), c.min_depth_m, c.max_depth_m, depth_out,
-                              table.pixel_count());
+  detail::triangulate_subcode(refined, subcode_planes_of(table), table.ray_x(), table.ray_y(),
+                              c.min_depth_m, c.max_depth_m, depth_out, table.pixel_count());
 }
 
 /// The same one row at a time, as the refiner finishes each (the row still in the cache).
@@ -73,9 +76,7 @@ class RowTriangulator final : public detail::SubcodeRefiner::RowSink {
       : table_(table), c_(c), depth_out_(depth_out), width_(width) {}
   void row_done(int y, const float* refined_row) override {
     const std::ptrdiff_t offset = static_cast<std::ptrdiff_t>(y) * width_;
-    const detail::SubcodePlanes planes{table_.subcode_planes(), table_.subcode_steps(),
-                                       table_.subcode_plane_count(),
-                                       table_.linear_subcode_planes()};
+    const detail::SubcodePlanes planes = subcode_planes_of(table_);
     if (table_.column_ray_x() != nullptr) {  // separable rays: 8 bytes per pixel less to read
       detail::triangulate_subcode_row(refined_row, planes, table_.column_ray_x(),
                                       table_.row_ray_y()[y], c_.min_depth_m, c_.max_depth_m,

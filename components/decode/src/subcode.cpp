@@ -58,15 +58,14 @@ namespace {
 #define AVS_SUBCODE_CLONES
 #endif
 
-// Per column running sums of the window (SubcodeRefiner's arrays), in 32 or 16 bits.
-template <class T>
+// Per column running sums of the window (SubcodeRefiner's 32-bit arrays).
 struct Sums {
-  T* __restrict n;
-  T* __restrict sd;
-  T* __restrict sdd;
-  T* __restrict sc;
-  T* __restrict scd;
-  T* __restrict jumps;
+  std::int32_t* __restrict n;
+  std::int32_t* __restrict sd;
+  std::int32_t* __restrict sdd;
+  std::int32_t* __restrict sc;
+  std::int32_t* __restrict scd;
+  std::int32_t* __restrict jumps;
 };
 
 // The sums the 16-column AVX2 step keeps per column (16 bits): count, code, discontinuities.
@@ -85,7 +84,7 @@ struct StepArgs {
   float* out;               ///< refined row y0
   std::int16_t* previous;
   std::int32_t* previous_y;
-  Sums<std::int32_t> s;
+  Sums s;
   int width, y_in, d_in, d_out, reach, max_jump;
   /// The 16-bit sums and previous rows when they are exact (SubcodeRefiner), else null.
   const NarrowSums* narrow;
@@ -119,7 +118,7 @@ void window_step_plain(const StepArgs& a, int begin) {
   float* __restrict out = a.out;
   std::int16_t* __restrict previous = a.previous;
   std::int32_t* __restrict previous_y = a.previous_y;
-  const Sums<std::int32_t> s = a.s;
+  const Sums s = a.s;
   const int y_in = a.y_in, d_in = a.d_in, d_out = a.d_out, reach = a.reach;
   const int max_jump = a.max_jump;
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -335,7 +334,7 @@ AVS_AVX2_INLINE __m256 fit8(const Window8& w, __m256i c0, const WindowConstants8
 // 32 columns wide, for the byte flags, and spilled its sums to the stack).
 template <bool kAdd, bool kRemove, bool kOutput>
 __attribute__((target("avx2"))) void window_step_avx2(const StepArgs& a) {
-  const Sums<std::int32_t> s = a.s;
+  const Sums s = a.s;
   const WindowConstants8 k(a.d_in, a.d_out, a.reach, a.max_jump);
   const __m256i y_in = _mm256_set1_epi32(a.y_in);
   int x = 0;
@@ -745,8 +744,7 @@ void SubcodeRefiner::refine(const std::int16_t* codes, float* refined, RowSink* 
   std::fill(sc_.begin(), sc_.end(), 0);
   std::fill(scd_.begin(), scd_.end(), 0);
   std::fill(jumps_.begin(), jumps_.end(), 0);
-  const Sums<std::int32_t> sums{n_.data(),  sd_.data(),  sdd_.data(),
-                                sc_.data(), scd_.data(), jumps_.data()};
+  const Sums sums{n_.data(), sd_.data(), sdd_.data(), sc_.data(), scd_.data(), jumps_.data()};
   if (narrow_) {
     for (auto* v : {&n16_, &sc16_, &jumps16_}) std::fill(v->begin(), v->end(), std::int16_t{0});
     std::fill(previous_y16_.begin(), previous_y16_.end(), std::numeric_limits<std::int16_t>::min());
