@@ -34,7 +34,7 @@ enum class Corruption : int {
   wrong_function_code  ///< a 0x03 reply to a 0x17 or 0x10 request, 0x04 to a 0x03 one
 };
 
-bool read_exact(int fd, std::uint8_t* data, std::size_t size) {
+bool recv_exact(int fd, std::uint8_t* data, std::size_t size) {
   std::size_t done = 0;
   while (done < size) {
     const ssize_t n = ::recv(fd, data + done, size - done, 0);
@@ -57,11 +57,11 @@ bool write_all(int fd, const std::vector<std::uint8_t>& data) {
 /// One MBAP frame (7-byte header, then length - 1 bytes), as sent by a well-behaved peer.
 bool read_frame(int fd, std::vector<std::uint8_t>& frame) {
   frame.resize(7);
-  if (!read_exact(fd, frame.data(), 7)) return false;
+  if (!recv_exact(fd, frame.data(), 7)) return false;
   const std::size_t length = (std::size_t{frame[4]} << 8) | frame[5];
   if (length < 1 || length > 254) return false;
   frame.resize(6 + length);
-  return read_exact(fd, frame.data() + 7, length - 1);
+  return recv_exact(fd, frame.data() + 7, length - 1);
 }
 
 /// Forwards whole MBAP frames between one client at a time and the amplifier server, and

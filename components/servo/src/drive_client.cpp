@@ -10,11 +10,11 @@
 
 #include <netinet/in.h>
 #include <netinet/tcp.h>
-#include <poll.h>
 #include <sys/socket.h>
 
 #include "avs/servo/modbus_frame.hpp"
 #include "avs/servo/plant.hpp"
+#include "avs/servo/socket_read.hpp"
 
 namespace avs::servo {
 namespace {
@@ -431,38 +431,6 @@ DriveClient::ExchangeError DriveClient::classify_modbus_errno(int err) {
   }
   return ExchangeError::io;
 }
-
-namespace {
-
-/// Waits until `fd` is readable or the deadline (steady clock) has passed.
-bool wait_readable(int fd, std::chrono::steady_clock::time_point deadline) {
-  const auto left = deadline - std::chrono::steady_clock::now();
-  if (left <= std::chrono::steady_clock::duration::zero()) return false;
-  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(left).count();
-  timespec timeout{static_cast<time_t>(ns / 1'000'000'000), static_cast<long>(ns % 1'000'000'000)};
-  pollfd p{fd, POLLIN, 0};
-  return ::ppoll(&p, 1, &timeout, nullptr) > 0;
-}
-
-enum class ReadResult : std::uint8_t { ok, timeout, closed };
-
-ReadResult read_exact(int fd, std::span<std::uint8_t> out,
-                      std::chrono::steady_clock::time_point deadline) {
-  std::size_t done = 0;
-  while (done < out.size()) {
-    if (!wait_readable(fd, deadline)) return ReadResult::timeout;
-    const ssize_t n = ::recv(fd, out.data() + done, out.size() - done, 0);
-    if (n == 0) return ReadResult::closed;
-    if (n < 0) {
-      if (errno == EINTR || errno == EAGAIN) continue;
-      return ReadResult::closed;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return ReadResult::ok;
-}
-
-}  // namespace
 
 DriveClient::ExchangeError DriveClient::tcp_transaction(std::uint8_t unit_id,
                                                         const RequestPdu& request,
