@@ -29,6 +29,7 @@
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <tuple>
 #include <unordered_map>
 
 #include "avs/bench/report.hpp"
@@ -41,6 +42,7 @@
 #include "avs_child.hpp"
 #include "dds_environment.hpp"
 #include "graph_loading.hpp"
+#include "host_stall_probe.hpp"
 
 namespace avs::cli {
 namespace {
@@ -342,6 +344,11 @@ struct PlacementResult {
   double cpu_percent_pipeline = 0, cpu_percent_source = -1;  ///< -1: same process
   std::string transport;
   std::string loadavg;
+  /// Wake-ups of a 1 kHz sleeper in the bench process more than 3 ms late during the
+  /// placement's run, start-up included (HostStallProbe): the host's stalls and, here, the
+  /// contention of the run's own threads for the cores.
+  int host_stalls = 0;
+  double host_stall_max_ms = 0;
   std::int64_t dropped() const {
     return decode_dropped + decode_out_of_order + depth_missing + tracking_missing +
            matching_missing;
@@ -373,6 +380,7 @@ PlacementResult run_placement(const Options& o, const std::string& placement, in
                     [&](const graph::ContainerSpec& c) { return c.name != "source"; });
   runtime::Container container(*graph, spec);
   int status = 1;
+  const HostStallProbe stalls;
   std::thread runner([&] { status = container.run(); });
   if (intra) {
     runner.join();
@@ -453,6 +461,8 @@ PlacementResult run_placement(const Options& o, const std::string& placement, in
                      (1e-9 * static_cast<double>(p.last_pose_ns - p.first_pose_ns));
   }
   r.loadavg = bench::load_average();
+  std::tie(r.host_stalls, r.host_stall_max_ms) = stalls.since(0.0);
+  stalls.write_csv((dir / (placement + "_stalls.csv")).string());
   return r;
 }
 
@@ -540,6 +550,9 @@ void add_rows(bench::Report& report, const PlacementResult& r) {
   if (r.cpu_percent_source >= 0) {
     report.rows.push_back({n + ": CPU, source process", "%", r.cpu_percent_source, "", 0});
   }
+  report.rows.push_back(
+      {n + ": stalls (1 kHz sleeper > 3 ms late)", "", static_cast<double>(r.host_stalls), "", 0});
+  report.rows.push_back({n + ": longest stall", "ms", r.host_stall_max_ms, "", 0});
   const std::string key = "placement." + n + ".";
   report.json[key + "latency_ms_p50"] = lat.p50;
   report.json[key + "latency_ms_p99"] = lat.p99;
@@ -555,6 +568,8 @@ void add_rows(bench::Report& report, const PlacementResult& r) {
   report.json[key + "source_missed_slots"] = static_cast<double>(r.missed_slots);
   report.json[key + "source_late_frames"] = static_cast<double>(r.late_frames);
   report.json[key + "source_max_late_ms"] = r.max_late_ms;
+  report.json[key + "host_stalls"] = static_cast<double>(r.host_stalls);
+  report.json[key + "host_stall_max_ms"] = r.host_stall_max_ms;
   report.json[key + "decode_dropped_frames"] = static_cast<double>(r.decode_dropped);
   report.json[key + "decode_out_of_order_frames"] = static_cast<double>(r.decode_out_of_order);
   report.json[key + "depth_missing"] = static_cast<double>(r.depth_missing);

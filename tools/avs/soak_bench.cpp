@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -28,6 +29,7 @@
 #include "avs_child.hpp"
 #include "dds_environment.hpp"
 #include "graph_loading.hpp"
+#include "host_stall_probe.hpp"
 #include "probe_container.hpp"
 
 namespace avs::cli {
@@ -237,6 +239,7 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
   const SoakProbe* probe = &probe_container.probe();
 
   std::map<std::string, Series> series;
+  std::optional<HostStallProbe> stalls;
   std::map<std::string, double> counters_after_warm_up, counters_end;
   std::int64_t poses_after_warm_up = 0, poses_end = 0;
   const fs::path launch_log = dir / "launch.log";
@@ -250,6 +253,7 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
     std::fprintf(stderr, "avs bench soak: launched %s for %g min (log %s)\n", o.graph.c_str(),
                  o.minutes, launch_log.c_str());
     std::map<std::string, pid_t> pids;
+    stalls.emplace();  // its clock starts with the run's
     const auto start = std::chrono::steady_clock::now();
     const double run_s = 60.0 * o.minutes;
     bool warm = false;
@@ -307,7 +311,8 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
   for (const std::string& name : containers) {
     const Series& s = series[name];
     const double rss_slope = slope(s.t_min, s.rss_kib), fd_slope = slope(s.t_min, s.fds);
-    report.rows.push_back({name + ": resident memory growth after warm-up", "KiB/min", rss_slope, "", 0});
+    report.rows.push_back(
+        {name + ": resident memory growth after warm-up", "KiB/min", rss_slope, "", 0});
     report.rows.push_back(
         {name + ": open descriptors growth after warm-up", "fds/min", fd_slope, "", 0});
     const double rss_peak_growth = peak_growth(s.t_min, s.rss_kib);
@@ -351,6 +356,22 @@ bench::Report soak_bench(const std::vector<std::string>& args) {
   report.rows.push_back({"poses per second after warm-up", "Hz", pose_rate_hz, "", 0});
   report.rows.push_back(
       {"loss counters that rose after warm-up", "", static_cast<double>(rising), "", 0});
+  // The host's own stalls beside them: a drive reply later than its timeout, a skipped frame
+  // while every thread on the machine stood still is a figure of the host (docs/reliability.md).
+  const auto [host_stalls, host_stall_max_ms] = stalls->since(o.warm_up_s);
+  stalls->write_csv((dir / "stalls.csv").string());
+  report.rows.push_back({"host stalls after warm-up (1 kHz sleeper > 3 ms late)", "",
+                         static_cast<double>(host_stalls), "", 0});
+  report.rows.push_back({"longest host stall after warm-up", "ms", host_stall_max_ms, "", 0});
+  report.json["host_stalls_after_warm_up"] = host_stalls;
+  report.json["host_stall_max_ms"] = host_stall_max_ms;
+  if (rising > 0 && host_stalls > 0) {
+    report.notes.push_back(
+        "the host stalled " + std::to_string(host_stalls) + " times after the warm-up (longest " +
+        std::to_string(host_stall_max_ms) + " ms; wall-clock times in " +
+        (dir / "stalls.csv").string() +
+        "): compare them with the times of the loss counters' log lines in " + launch_log.string());
+  }
   report.notes.push_back(
       "goal (issue 20 section 5): no growth of memory or descriptors after the warm-up, no loss "
       "counter rising; growth is the least-squares slope of the samples after the warm-up, peak "
