@@ -49,6 +49,8 @@ struct Run {
   int hidden_updates_with_pose = 0;  ///< of them, updates that still gave a pose
   double whole_again_s = -1;         ///< first time after the occlusion with >= 98 % again
   double reacquired_s = -1;          ///< first pose after whole_again_s within 10 mm and 5 deg
+  /// The ICP pose's rotation from the tracker's prediction over the tracked updates: p99, max.
+  double step_p99_deg = 0, step_max_deg = 0;
 };
 
 struct Setup {
@@ -229,6 +231,7 @@ Run run(const Setup& setup) {
       (setup.closed_loop_tuning ? ", closed-loop tuning" : "") + ", " +
       sim::to_string(setup.profile) + " sensor";
   double total_ms = 0;
+  std::vector<double> steps_deg;  // Run::step_p99_deg
   const int frames = static_cast<int>(setup.end_s * sim_config.frame_rate_hz);
   const int window = 2 * decoder_config.geometry.layout.bit_count;
   for (int f = 0; f < frames; ++f) {
@@ -293,12 +296,13 @@ Run run(const Setup& setup) {
           pose_error(result.track.T_camera_model,
                      frame.truth.objects[0].T_camera_object.cast<float>(), object.symmetry);
       std::printf(
-          "t %.3f px %zu pts %zu state %s init %d valid %d rmse %.2f mm inl %.2f err %.1f mm %.1f "
-          "deg dxyz %.1f %.1f %.1f mm z %.1f mm\n",
+          "t %.3f px %zu pts %zu state %s init %d valid %d from prediction %.2f deg %.1f mm rmse "
+          "%.2f mm inl %.2f err %.1f mm %.1f deg dxyz %.1f %.1f %.1f mm z %.1f mm\n",
           t, result.valid_pixels, result.scene_points, to_string(result.track.state),
           result.track.initialised_this_frame ? 1 : 0, result.track.pose_valid ? 1 : 0,
-          1e3 * result.track.icp.rmse_m, result.track.icp.inlier_ratio(), 1e3 * e.translation_m,
-          e.rotation_deg,
+          result.track.rotation_from_prediction_deg,
+          1e3 * result.track.translation_from_prediction_m, 1e3 * result.track.icp.rmse_m,
+          result.track.icp.inlier_ratio(), 1e3 * e.translation_m, e.rotation_deg,
           1e3 * (result.track.T_camera_model.translation().x() -
                  frame.truth.objects[0].T_camera_object.translation().x()),
           1e3 * (result.track.T_camera_model.translation().y() -
@@ -308,6 +312,9 @@ Run run(const Setup& setup) {
           1e3 * frame.truth.objects[0].T_camera_object.translation().z());
     }
     total_ms += result.processing_ms;
+    if (std::isfinite(result.track.rotation_from_prediction_deg)) {
+      steps_deg.push_back(result.track.rotation_from_prediction_deg);
+    }
     if (reference) {
       const bool hidden = target_coded_fraction < 0.05;
       out.hidden_updates += hidden ? 1 : 0;
@@ -330,6 +337,11 @@ Run run(const Setup& setup) {
                        frame.truth.objects[0].T_camera_object.cast<float>()});
   }
   out.mean_ms = total_ms / std::max(out.depth_updates, 1);
+  if (!steps_deg.empty()) {
+    std::sort(steps_deg.begin(), steps_deg.end());
+    out.step_p99_deg = steps_deg[(steps_deg.size() - 1) * 99 / 100];
+    out.step_max_deg = steps_deg.back();
+  }
 
   // Errors at the newest frame's time, camera frame, modulo the object's symmetry.
   double sp = 0, sr = 0;
@@ -368,6 +380,9 @@ Run run(const Setup& setup) {
       out.label.c_str(), out.depth_updates, out.poses, out.position_rms_mm, out.position_max_mm,
       out.rotation_rms_deg, out.rotation_max_deg, out.flips, out.best_lag_ms, out.mean_ms,
       out.initial_ms);
+  std::printf(
+      "rotation of the ICP pose from the tracker's prediction: p99 %.2f deg, max %.2f deg\n",
+      out.step_p99_deg, out.step_max_deg);
   if (reference) {
     std::printf(
         "occluder: %d updates with the target hidden (%d of them with a pose), whole again "

@@ -242,5 +242,45 @@ TEST(Tracker, ATargetLostWhileItsDataWasThereIsReinitialisedNotReacquired) {
   EXPECT_EQ(back.state, TrackingState::tracking);
 }
 
+// The tracker reports how far each frame's ICP pose is from the constant-velocity prediction it
+// started from (TrackResult::rotation_from_prediction_deg): the estimate's frame-to-frame jitter,
+// which the accuracy runs print beside the error (docs/matching.md). On clean data it is the
+// ken's own acceleration; a frame whose data is turned 10 deg pulls the ICP pose that far.
+TEST(Tracker, ReportsHowFarEachPoseIsFromItsPrediction) {
+  const ObjectPreset ken = builtin_objects()[0];
+  const ModelCloud model = test::model_of(ken);
+  Tracker tracker(model, {});
+  float largest_clean_deg = 0, pulled_deg = 0;
+  for (int k = 0; k < 120; ++k) {
+    const double t = 0.2 + k / 500.0;
+    Eigen::Isometry3f seen = trajectory(t);
+    if (k == 100) {
+      seen.linear() =
+          Eigen::AngleAxisf(10.0F * std::numbers::pi_v<float> / 180.0F, Eigen::Vector3f::UnitX()) *
+          seen.linear();
+    }
+    const TrackResult r =
+        tracker.update(test::scene_of(ken, model, seen, static_cast<std::uint32_t>(k)), t);
+    if (k == 0) {
+      EXPECT_TRUE(std::isnan(r.rotation_from_prediction_deg)) << "no prediction on the first frame";
+      EXPECT_TRUE(std::isnan(r.translation_from_prediction_m));
+      continue;
+    }
+    ASSERT_TRUE(std::isfinite(r.rotation_from_prediction_deg)) << "frame " << k;
+    ASSERT_TRUE(std::isfinite(r.translation_from_prediction_m)) << "frame " << k;
+    if (k == 100) {
+      pulled_deg = r.rotation_from_prediction_deg;
+    } else if (k > 1 && k < 100) {
+      largest_clean_deg = std::max(largest_clean_deg, r.rotation_from_prediction_deg);
+    }
+  }
+  std::printf(
+      "rotation from the prediction: at most %.2f deg on clean data, %.2f deg on the "
+      "frame turned 10 deg\n",
+      largest_clean_deg, pulled_deg);
+  EXPECT_LT(largest_clean_deg, 3.0F);
+  EXPECT_GT(pulled_deg, 5.0F);
+}
+
 }  // namespace
 }  // namespace avs::matching

@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
+
+#include "avs/matching/pose_error.hpp"
 
 namespace avs::matching {
 
@@ -112,7 +115,8 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
 
   // 1. Pose guess: when not tracking, re-acquisition from the last valid pose (when recent)
   //    or else the initial alignment; when tracking, the prediction from the last poses.
-  bool as_initial = false;  // held to the initial alignment's inlier ratio
+  bool as_initial = false;                      // held to the initial alignment's inlier ratio
+  std::optional<Eigen::Isometry3f> prediction;  // while tracking: the ICP's start
   if (state_ != TrackingState::tracking) {
     as_initial = true;
     previous_pose_.reset();  // no velocity across a loss
@@ -140,10 +144,16 @@ TrackResult Tracker::update(const Points& p_camera, double stamp_s) {
     }
   } else {
     // 2. Fixed-count ICP from the guess.
-    result.icp = icp_.align(p_camera, predict(stamp_s));
+    prediction = predict(stamp_s);
+    result.icp = icp_.align(p_camera, *prediction);
   }
   result.T_camera_model = result.icp.T_camera_model;
   result.pose_valid = passes(result.icp, as_initial);
+  if (prediction) {
+    const PoseError step = pose_error(result.T_camera_model, *prediction, Symmetry::none);
+    result.rotation_from_prediction_deg = step.rotation_deg;
+    result.translation_from_prediction_m = step.translation_m;
+  }
 
   // 3. State machine: failures in a row declare the target lost; a lost target re-initialises.
   if (result.pose_valid) {

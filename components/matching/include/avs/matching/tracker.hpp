@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <optional>
 
 #include "avs/matching/icp.hpp"
@@ -57,7 +58,11 @@ struct TrackResult {
   bool initialised_this_frame = false;  ///< the initial alignment ran on this frame
   bool reacquired_this_frame = false;   ///< a lost target was found again from its last pose
   bool pose_valid = false;              ///< this frame passed the RMSE / inlier checks
-  IcpResult icp;                        ///< of this frame
+  /// While tracking: how far the ICP pose is from the prediction it started from (NaN when
+  /// there was none): the frame-to-frame jitter of the estimate beside its error.
+  float rotation_from_prediction_deg = std::numeric_limits<float>::quiet_NaN();
+  float translation_from_prediction_m = std::numeric_limits<float>::quiet_NaN();
+  IcpResult icp;  ///< of this frame
 };
 
 class Tracker {
