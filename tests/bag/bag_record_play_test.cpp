@@ -27,6 +27,7 @@
 #include "avs/runtime/raw_topic.hpp"
 #include "avs/testing/cpu_hog.hpp"
 #include "avs/testing/scratch_dir.hpp"
+#include "avs/testing/wait_scale.hpp"
 #include "bag_process.hpp"
 #include "rosgraph_msgs.h"
 #include "std_msgs.h"
@@ -519,7 +520,7 @@ std::map<std::string, TopicCheck> record_closed_loop(bool waits, std::string& ou
   AvsProcess rec({"bag", "record", "-a", "-o", file.string()},
                  temp_dir() / ("record_" + name + ".log"));
   EXPECT_TRUE(rec.started());
-  std::this_thread::sleep_for(1500ms);
+  std::this_thread::sleep_for(avs::testing::scaled(1500ms));  // the recorder up (not matched)
   {
     AvsProcess graph({"launch", source_dir() + "/launch_config/closed_loop.yaml",
                       "run_dir:=" + (temp_dir() / ("run_" + name)).string(),
@@ -531,7 +532,7 @@ std::map<std::string, TopicCheck> record_closed_loop(bool waits, std::string& ou
     // runs on: the recorder is continued at 1.5 s, 1000 steps later, far more than the
     // writers' 10-sample histories. Waiting, it hardly advances: continued after a second.
     SimClockWatch clock;
-    const auto give_up = std::chrono::steady_clock::now() + 120s;
+    const auto give_up = std::chrono::steady_clock::now() + avs::testing::scaled(120s);
     while (clock.now_s() < 0.5 && std::chrono::steady_clock::now() < give_up)
       std::this_thread::sleep_for(5ms);
     rec.signal(SIGSTOP);
@@ -542,11 +543,11 @@ std::map<std::string, TopicCheck> record_closed_loop(bool waits, std::string& ou
         std::this_thread::sleep_for(5ms);
     }
     rec.signal(SIGCONT);
-    EXPECT_EQ(exit_code(graph.wait(300s)), 0) << graph.output();
+    EXPECT_EQ(exit_code(graph.wait(avs::testing::scaled(300s))), 0) << graph.output();
   }
   std::this_thread::sleep_for(300ms);
   rec.signal(SIGINT);
-  status = rec.wait(30s);
+  status = rec.wait(avs::testing::scaled(30s));
   out = rec.output();
   std::printf("%s", out.c_str());
 
