@@ -129,9 +129,10 @@ case "${1:-}" in
       # process, malformed samples (issue 20 section 4).
       suites+='|RateWarning|SkipToNewest|DecodeComponent'
       # The two closed-loop recordings (3 s of the lockstep closed loop each) take more than their
-      # 300 s under TSan: left out (docs/reliability.md "Sanitizers").
+      # 300 s under TSan: left out here (docs/reliability.md "Sanitizers").
       # `--closed-loop` runs just those two, their waits scaled (AVS_TEST_WAIT_SCALE) and one at a
-      # time: each is 3 s of the closed loop beside a CPU hog (about 20-40 min under TSan).
+      # time: each is 3 s of the closed loop beside a CPU hog (12 min under TSan alone, 37 min
+      # beside a CI run: docs/reliability.md "Sanitizers").
       status=0
       closed_loop_tests='BagRecord\.(ReportedLossEqualsTheGaps|ALockstepGraphWaitsForItsRecorder)'
       if [ "$closed_loop" = true ]; then
