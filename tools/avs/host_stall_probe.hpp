@@ -11,13 +11,13 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <cstdio>
-#include <ctime>
 #include <fstream>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "avs/runtime/log_clock.hpp"
 
 namespace avs::cli {
 
@@ -40,7 +40,6 @@ class HostStallProbe {
   HostStallProbe(const HostStallProbe&) = delete;
   HostStallProbe& operator=(const HostStallProbe&) = delete;
 
-  double threshold_ms() const { return threshold_ms_; }
   /// The stalls so far, oldest first.
   std::vector<Stall> stalls() const {
     std::lock_guard lock(mutex_);
@@ -75,22 +74,12 @@ class HostStallProbe {
       const auto now = Clock::now();
       const double late_ms = std::chrono::duration<double, std::milli>(now - next).count();
       if (late_ms <= threshold_ms_) continue;
-      const auto wall = std::chrono::system_clock::now();
-      const std::time_t seconds = std::chrono::system_clock::to_time_t(wall);
-      std::tm local{};
-      localtime_r(&seconds, &local);
-      char text[32];
-      std::snprintf(
-          text, sizeof text, "%02d:%02d:%02d.%03d", local.tm_hour, local.tm_min, local.tm_sec,
-          static_cast<int>(
-              std::chrono::duration_cast<std::chrono::milliseconds>(wall.time_since_epoch())
-                  .count() %
-              1000));
+      const std::string wall = runtime::log_clock_text(std::chrono::system_clock::now());
       {
         std::lock_guard lock(mutex_);
         // Bounded: a week-long soak on a bad host keeps its first 100,000 stalls.
         if (stalls_.size() < 100000) {
-          stalls_.push_back({std::chrono::duration<double>(now - start_).count(), late_ms, text});
+          stalls_.push_back({std::chrono::duration<double>(now - start_).count(), late_ms, wall});
         }
       }
       next = now;  // one stall is one record, not a burst of catch-up wake-ups
